@@ -1,0 +1,128 @@
+"""Assembly of the bladed rotor and the casing in the rotating frame.
+
+Dof order: shaft (2 x n_shaft, interleaved x/y), blades (N x n_blade), casing
+(translation, tilt, ring modes). Each component builds its own matrices; this
+module only places them. Rotor and casing are coupled only through contact.
+
+Examples
+--------
+>>> from rotorub_model.model import build_model
+>>> m = build_model()
+>>> m.n_dofs
+38
+>>> m.dofs[0], m.dofs[-1]
+('shaft.a0.x', 'casing.n3.y')
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from .blades import bladed_disk_matrices
+from .casing import casing_matrices
+from .frames import Matrices
+from .params import Parameters, reference_parameters
+from .shaft import shaft_matrices, station_maps
+
+
+@dataclass
+class Model:
+    """Rotating-frame linear model: M q'' + (D + G(W)) q' + K(W) q = F(W^2).
+
+    K(W) = K + Ks(W^2) + N(W) + C(W), with G = W G1, C = W C1, N = W^2 N2, Ks = W^2 S2.
+    """
+
+    params: Parameters
+    dofs: list[str]
+    M: np.ndarray
+    D: np.ndarray
+    K: np.ndarray
+    G1: np.ndarray
+    C1: np.ndarray
+    N2: np.ndarray
+    S2: np.ndarray
+    f_unit: np.ndarray  # imbalance force for m e = 1 kg m at Omega = 1 rad/s
+    slices: dict[str, slice]
+
+    @property
+    def n_dofs(self) -> int:
+        return len(self.dofs)
+
+    def G(self, omega: float) -> np.ndarray:
+        return omega * self.G1
+
+    def K_omega(self, omega: float) -> np.ndarray:
+        """K(Omega) = K + Ks(Omega^2) + N(Omega) + C(Omega)."""
+        return self.K + omega * omega * (self.S2 + self.N2) + omega * self.C1
+
+    def force(self, omega: float, me: float | None = None) -> np.ndarray:
+        """Imbalance force F(Omega^2) (constant in the rotating frame)."""
+        me = self.params.imbalance.me if me is None else me
+        return me * omega * omega * self.f_unit
+
+    def index(self, name: str) -> int:
+        return self.dofs.index(name)
+
+    @cached_property
+    def disk_maps(self) -> tuple[np.ndarray, np.ndarray]:
+        """(T, R), 3 x n: fan-disk translation and rotation vector from q."""
+        p = self.params
+        Ts, Rs = station_maps(p, p.fan_disk.z)
+        T = np.zeros((3, self.n_dofs))
+        R = np.zeros((3, self.n_dofs))
+        T[:, self.slices["shaft"]] = Ts
+        R[:, self.slices["shaft"]] = Rs
+        return T, R
+
+    def omega_norm(self, omega: float | np.ndarray) -> float | np.ndarray:
+        return np.asarray(omega) / self.params.normalisation.omega_ref
+
+    def omega_si(self, omega_norm: float | np.ndarray) -> float | np.ndarray:
+        return np.asarray(omega_norm) * self.params.normalisation.omega_ref
+
+
+def _place(n: int, parts: list[tuple[Matrices, np.ndarray]]) -> dict[str, np.ndarray]:
+    out = {k: np.zeros((n, n)) for k in ("M", "D", "K", "G1", "C1", "N2", "S2")}
+    for mats, idx in parts:
+        ix = np.ix_(idx, idx)
+        for k in out:
+            out[k][ix] += getattr(mats, k)
+    return out
+
+
+def build_model(params: Parameters | None = None) -> Model:
+    """Assemble the model of ``params`` (default: the embedded reference)."""
+    p = params or reference_parameters()
+    sh = shaft_matrices(p)
+    bd = bladed_disk_matrices(p)
+    cs = casing_matrices(p)
+    ns = len(sh.dofs)
+    nbt = len(bd.dofs) - ns
+    nc = len(cs.dofs)
+    n = ns + nbt + nc
+    slices = {
+        "shaft": slice(0, ns),
+        "blades": slice(ns, ns + nbt),
+        "rotor": slice(0, ns + nbt),
+        "casing": slice(ns + nbt, n),
+    }
+    dofs = sh.dofs + bd.dofs[ns:] + cs.dofs
+    mats = _place(
+        n,
+        [
+            (sh, np.arange(ns)),
+            (bd, np.arange(ns + nbt)),
+            (cs, np.arange(ns + nbt, n)),
+        ],
+    )
+    model = Model(params=p, dofs=dofs, f_unit=np.zeros(n), slices=slices, **mats)
+    T, _ = model.disk_maps
+    ang = np.radians(p.imbalance.angle_deg)
+    Ts, _ = station_maps(p, next(d for d in p.disks if d.name == p.imbalance.disk).z)
+    f = np.zeros(n)
+    f[slices["shaft"]] = Ts.T @ np.array([np.cos(ang), np.sin(ang), 0.0])
+    model.f_unit = f
+    return model

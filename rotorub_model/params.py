@@ -1,0 +1,363 @@
+"""Typed, validated parameters of the bladed rotor / casing model (SI units).
+
+Every field carries its accepted range in its metadata; :func:`load_parameters`
+reads a TOML file, rejects unknown, missing, non-finite and out-of-range values
+with a :class:`~rotorub_model.errors.ParameterError` naming ``section.field`` and
+the accepted range, then checks the cross-field consistency rules.
+
+Examples
+--------
+>>> from rotorub_model.params import reference_parameters
+>>> p = reference_parameters()
+>>> p.blades.count
+10
+>>> round(p.blades.tip_radius, 3)
+1.0
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from dataclasses import dataclass, field, fields
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from .errors import ParameterError
+
+INF = math.inf
+
+
+def _f(lo: float, hi: float = INF, *, lo_open: bool = False, doc: str = "", integer: bool = False):
+    """A dataclass field with an accepted range [lo, hi] (or (lo, hi] if lo_open)."""
+    return field(metadata={"range": (lo, hi, lo_open), "doc": doc, "integer": integer})
+
+
+@dataclass(frozen=True)
+class ShaftParams:
+    E: float = _f(0, lo_open=True, doc="Young's modulus [Pa]")
+    rho: float = _f(0, lo_open=True, doc="density [kg/m^3]")
+    outer_diameter: float = _f(0, lo_open=True, doc="outer diameter [m]")
+    inner_diameter: float = _f(0, doc="inner diameter [m] (0 = solid)")
+    length: float = _f(0, lo_open=True, doc="length [m]; z=0 at the fan end, +z downstream")
+    n_ritz: int = _f(2, 14, integer=True, doc="component-mode Ritz functions per transverse direction")
+
+    @property
+    def area(self) -> float:
+        return math.pi / 4 * (self.outer_diameter**2 - self.inner_diameter**2)
+
+    @property
+    def second_moment(self) -> float:
+        return math.pi / 64 * (self.outer_diameter**4 - self.inner_diameter**4)
+
+
+@dataclass(frozen=True)
+class BearingParams:
+    name: str
+    z: float = _f(0, doc="axial position [m]")
+    k: float = _f(0, lo_open=True, doc="isotropic radial stiffness [N/m]")
+    c: float = _f(0, doc="isotropic radial damping [N s/m]")
+
+
+@dataclass(frozen=True)
+class DiskParams:
+    name: str
+    z: float = _f(0, doc="axial position [m]")
+    mass: float = _f(0, lo_open=True, doc="mass [kg]")
+    Ip: float = _f(0, doc="polar moment of inertia [kg m^2]")
+    Id: float = _f(0, doc="diametral moment of inertia [kg m^2]")
+
+
+@dataclass(frozen=True)
+class BladeParams:
+    count: int = _f(2, 200, integer=True, doc="number of blades")
+    hub_radius: float = _f(0, lo_open=True, doc="clamping radius r_d on the fan disk [m]")
+    length: float = _f(0, lo_open=True, doc="blade length l_b [m]")
+    width: float = _f(0, lo_open=True, doc="section width (chord of the beam section) [m]")
+    thickness: float = _f(0, lo_open=True, doc="section thickness (flexible direction) [m]")
+    E: float = _f(0, lo_open=True, doc="Young's modulus [Pa]")
+    rho: float = _f(0, lo_open=True, doc="density [kg/m^3]")
+    stagger_deg: float = _f(0, 90, doc="stagger angle from the axial direction [deg]")
+    n_ritz: int = _f(1, 12, integer=True, doc="polynomial Ritz functions per blade")
+    damping_ratio: float = _f(0, 0.5, doc="modal damping ratio of blade bending (rotating frame)")
+
+    @property
+    def tip_radius(self) -> float:
+        return self.hub_radius + self.length
+
+    @property
+    def area(self) -> float:
+        return self.width * self.thickness
+
+    @property
+    def second_moment(self) -> float:
+        return self.width * self.thickness**3 / 12.0
+
+    @property
+    def mass(self) -> float:
+        return self.rho * self.area * self.length
+
+
+@dataclass(frozen=True)
+class CasingParams:
+    mass: float = _f(0, lo_open=True, doc="rigid-body mass of the casing [kg]")
+    tilt_inertia: float = _f(0, lo_open=True, doc="diametral inertia about its centre of gravity [kg m^2]")
+    z_cg: float = _f(-INF, doc="axial offset of the casing centre of gravity from the blade-tip plane [m]")
+    ring_thickness: float = _f(0, lo_open=True, doc="radial thickness of the elastic ring [m]")
+    ring_width: float = _f(0, lo_open=True, doc="axial width of the elastic ring [m]")
+    E: float = _f(0, lo_open=True, doc="Young's modulus of the ring [Pa]")
+    rho: float = _f(0, lo_open=True, doc="density of the ring [kg/m^3]")
+    modes: tuple[int, ...] = field(metadata={"doc": "nodal diameters of the ring modes"})
+    damping_ratio: float = _f(0, 0.5, doc="modal damping ratio of the ring modes (fixed frame)")
+
+
+@dataclass(frozen=True)
+class SuspensionParams:
+    k_translation: float = _f(0, lo_open=True, doc="isotropic translational stiffness [N/m]")
+    c_translation: float = _f(0, doc="isotropic translational damping [N s/m]")
+    k_rotation: float = _f(0, lo_open=True, doc="isotropic tilt stiffness [N m/rad]")
+    c_rotation: float = _f(0, doc="isotropic tilt damping [N m s/rad]")
+
+
+@dataclass(frozen=True)
+class ImbalanceParams:
+    disk: str
+    me: float = _f(0, doc="imbalance m*e [kg m]")
+    angle_deg: float = _f(-360, 360, doc="angular position of the imbalance in the rotating frame [deg]")
+
+
+@dataclass(frozen=True)
+class ContactParams:
+    k_r: float = _f(0, lo_open=True, doc="normal penalty stiffness of one whole blade tip [N/m]")
+    mu: float = _f(0, 2, doc="Coulomb friction coefficient")
+    theta_deg: float = _f(0, 60, doc="inclination of the conical casing inner surface [deg]")
+    chord: float = _f(0, lo_open=True, doc="blade tip chord length l_c [m]")
+    g0: float = _f(-INF, doc="nominal tip clearance [m] (negative = initial interference)")
+
+
+@dataclass(frozen=True)
+class NormalisationParams:
+    omega_ref: float = _f(0, lo_open=True, doc="reference angular speed for the normalised spin speed [rad/s]")
+
+
+@dataclass(frozen=True)
+class Parameters:
+    """The whole model: one object per component, all values in SI units."""
+
+    shaft: ShaftParams
+    bearings: tuple[BearingParams, ...]
+    disks: tuple[DiskParams, ...]
+    blades: BladeParams
+    casing: CasingParams
+    suspension: SuspensionParams
+    imbalance: ImbalanceParams
+    contact: ContactParams
+    normalisation: NormalisationParams
+
+    def replace(self, **sections: dict[str, Any]) -> "Parameters":
+        """Return a copy with some fields of some sections replaced, validated again.
+
+        >>> p = reference_parameters().replace(contact={"g0": 1e-3})
+        >>> p.contact.g0
+        0.001
+        """
+        data = to_dict(self)
+        for sec, values in sections.items():
+            if sec not in data:
+                raise ParameterError(f"unknown section '{sec}'; accepted: {', '.join(data)}")
+            if isinstance(data[sec], list):
+                data[sec] = values
+            else:
+                data[sec] = {**data[sec], **values}
+        return from_dict(data)
+
+    @property
+    def fan_disk(self) -> DiskParams:
+        return next(d for d in self.disks if d.name == self.imbalance.disk)
+
+
+_SECTIONS: dict[str, type] = {
+    "shaft": ShaftParams,
+    "blades": BladeParams,
+    "casing": CasingParams,
+    "suspension": SuspensionParams,
+    "imbalance": ImbalanceParams,
+    "contact": ContactParams,
+    "normalisation": NormalisationParams,
+}
+_LISTS: dict[str, type] = {"bearings": BearingParams, "disks": DiskParams}
+
+
+def _range_text(lo: float, hi: float, lo_open: bool) -> str:
+    left = "(" if lo_open else "["
+    right = "]" if hi != INF else ")"
+    return f"{left}{lo:g}, {hi:g}{right}" if hi != INF else f"{left}{lo:g}, inf)"
+
+
+def _check_value(where: str, f: dataclasses.Field, value: Any) -> Any:
+    meta = f.metadata
+    if f.name == "modes":
+        if not isinstance(value, list | tuple) or not value:
+            raise ParameterError(f"{where}: expected a non-empty list of integers >= 2")
+        for n in value:
+            if not isinstance(n, int) or isinstance(n, bool) or n < 2:
+                raise ParameterError(f"{where}: nodal diameter {n!r} out of range; accepted: integers >= 2")
+        if len(set(value)) != len(value):
+            raise ParameterError(f"{where}: repeated nodal diameter in {list(value)}")
+        return tuple(int(n) for n in value)
+    if f.type in ("str", str):
+        if not isinstance(value, str) or not value:
+            raise ParameterError(f"{where}: expected a non-empty string, got {value!r}")
+        return value
+    lo, hi, lo_open = meta["range"]
+    rng = _range_text(lo, hi, lo_open)
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ParameterError(f"{where}: expected a number in {rng}, got {value!r}")
+    if meta.get("integer"):
+        if not isinstance(value, int) and not float(value).is_integer():
+            raise ParameterError(f"{where}: expected an integer in {rng}, got {value!r}")
+        value = int(value)
+    else:
+        value = float(value)
+    if not math.isfinite(value):
+        raise ParameterError(f"{where}: value {value} is not finite; accepted range {rng}")
+    if value < lo or (lo_open and value == lo) or value > hi:
+        raise ParameterError(f"{where}: value {value:g} out of range; accepted range {rng}")
+    return value
+
+
+def _build(cls: type, where: str, data: Any) -> Any:
+    if not isinstance(data, dict):
+        raise ParameterError(f"{where}: expected a table of fields, got {type(data).__name__}")
+    names = {f.name for f in fields(cls)}
+    unknown = sorted(set(data) - names)
+    if unknown:
+        raise ParameterError(f"{where}.{unknown[0]}: unknown field; accepted fields: {', '.join(sorted(names))}")
+    kwargs = {}
+    for f in fields(cls):
+        if f.name not in data:
+            if f.default is not dataclasses.MISSING:
+                kwargs[f.name] = f.default
+                continue
+            raise ParameterError(f"{where}.{f.name}: missing ({f.metadata.get('doc', 'required')})")
+        kwargs[f.name] = _check_value(f"{where}.{f.name}", f, data[f.name])
+    return cls(**kwargs)
+
+
+def from_dict(data: dict[str, Any]) -> Parameters:
+    """Build and validate :class:`Parameters` from a nested dict (as read from TOML)."""
+    if not isinstance(data, dict):
+        raise ParameterError("parameters: expected a table of sections")
+    known = set(_SECTIONS) | set(_LISTS)
+    unknown = sorted(set(data) - known)
+    if unknown:
+        raise ParameterError(f"{unknown[0]}: unknown section; accepted: {', '.join(sorted(known))}")
+    kwargs: dict[str, Any] = {}
+    for sec, cls in _SECTIONS.items():
+        if sec not in data:
+            raise ParameterError(f"{sec}: missing section")
+        kwargs[sec] = _build(cls, sec, data[sec])
+    for sec, cls in _LISTS.items():
+        items = data.get(sec)
+        if not isinstance(items, list) or not items:
+            raise ParameterError(f"{sec}: missing; expected a non-empty array of tables [[{sec}]]")
+        kwargs[sec] = tuple(_build(cls, f"{sec}[{i}]", d) for i, d in enumerate(items))
+    p = Parameters(**kwargs)
+    _check_consistency(p)
+    return p
+
+
+def _check_consistency(p: Parameters) -> None:
+    s = p.shaft
+    if s.inner_diameter >= s.outer_diameter:
+        raise ParameterError(
+            f"shaft.inner_diameter: {s.inner_diameter:g} m must be < shaft.outer_diameter = {s.outer_diameter:g} m"
+        )
+    if len(p.bearings) < 1:
+        raise ParameterError("bearings: at least one bearing is needed")
+    for group, items in (("bearings", p.bearings), ("disks", p.disks)):
+        names = [it.name for it in items]
+        if len(set(names)) != len(names):
+            raise ParameterError(f"{group}: names must be unique, got {names}")
+        for i, it in enumerate(items):
+            if it.z > s.length:
+                raise ParameterError(f"{group}[{i}].z: {it.z:g} m out of range; accepted range [0, shaft.length={s.length:g}]")
+    if len(p.bearings) == 1:
+        raise ParameterError("bearings: two or more bearings are needed to hold the shaft (got 1)")
+    if p.imbalance.disk not in [d.name for d in p.disks]:
+        raise ParameterError(
+            f"imbalance.disk: '{p.imbalance.disk}' is not a disk; accepted: {', '.join(d.name for d in p.disks)}"
+        )
+    for d in p.disks:
+        if d.Ip > 2 * d.Id * (1 + 1e-9):
+            raise ParameterError(
+                f"disks[{d.name}].Ip: {d.Ip:g} kg m^2 violates the inertia triangle inequality; accepted range [0, 2*Id={2 * d.Id:g}]"
+            )
+    b = p.blades
+    if b.thickness > b.width:
+        raise ParameterError(
+            f"blades.thickness: {b.thickness:g} m must not exceed blades.width = {b.width:g} m "
+            "(the model bends the blade about its most flexible axis)"
+        )
+    casing_inner = b.tip_radius + max(p.contact.g0, 0.0)
+    if p.contact.g0 <= -0.5 * b.length:
+        raise ParameterError(f"contact.g0: {p.contact.g0:g} m out of range; accepted range (-blades.length/2, inf)")
+    if p.casing.ring_thickness >= casing_inner:
+        raise ParameterError("casing.ring_thickness: must be smaller than the casing inner radius")
+    half_chord_axial = 0.5 * p.contact.chord
+    if half_chord_axial >= b.tip_radius:
+        raise ParameterError(
+            f"contact.chord: {p.contact.chord:g} m out of range; accepted range (0, 2*tip radius={2 * b.tip_radius:g})"
+        )
+
+
+def load_parameters(path: str | Path | None = None) -> Parameters:
+    """Load and validate a parameter file; ``None`` loads the shipped reference.
+
+    Raises
+    ------
+    ParameterError
+        If the file cannot be read or parsed, or any value is invalid; the message
+        names the file and the offending field.
+    """
+    if path is None:
+        text = resources.files("rotorub_model").joinpath("data/reference.toml").read_text()
+        where = "reference.toml"
+    else:
+        try:
+            text = Path(path).read_text()
+        except OSError as exc:
+            raise ParameterError(f"parameter file '{path}': cannot be read ({exc.strerror or exc})") from None
+        where = str(path)
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError(f"parameter file '{where}': not valid TOML ({exc})") from None
+    try:
+        return from_dict(data)
+    except ParameterError as exc:
+        raise ParameterError(f"{where}: {exc}") from None
+
+
+_REFERENCE: Parameters | None = None
+
+
+def reference_parameters() -> Parameters:
+    """The embedded reference configuration (cached)."""
+    global _REFERENCE
+    if _REFERENCE is None:
+        _REFERENCE = load_parameters(None)
+    return _REFERENCE
+
+
+def to_dict(p: Parameters) -> dict[str, Any]:
+    """Nested plain-dict form of the parameters (round-trips through :func:`from_dict`)."""
+    out: dict[str, Any] = {}
+    for sec in _SECTIONS:
+        d = dataclasses.asdict(getattr(p, sec))
+        out[sec] = {k: (list(v) if isinstance(v, tuple) else v) for k, v in d.items()}
+    for sec in _LISTS:
+        out[sec] = [dataclasses.asdict(it) for it in getattr(p, sec)]
+    return out
