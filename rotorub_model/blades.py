@@ -111,7 +111,8 @@ def bladed_disk_matrices(p: Parameters, n_quad: int | None = None) -> Matrices:
             Q[sl, sl] += -R * fs[g]
             S2 -= dm * Q
     names = [f"shaft.a{i}.{c}" for i in range(p.shaft.n_ritz) for c in ("x", "y")] + blade_dof_names(p)
-    return Matrices(dofs=names, M=M, D=D, K=K, G1=G1, C1=np.zeros((n, n)), N2=N2, S2=S2)
+    # Euler force: d/dt (dm Omega e_z x r) . dr/dq gives dOmega/dt sum dm J^T Z J q = G1 / 2
+    return Matrices(dofs=names, M=M, D=D, K=K, G1=G1, C1=np.zeros((n, n)), N2=N2, S2=S2, E1=0.5 * G1)
 
 
 def blade_tip_map(p: Parameters, j: int) -> np.ndarray:

@@ -74,6 +74,96 @@ def cmd_campbell(ns: argparse.Namespace) -> dict:
     return {"n_speeds": len(r.speeds), "written": str(Path(ns.out) / "campbell.png")}
 
 
+def _executor(ns: argparse.Namespace):
+    if ns.executor == "serial":
+        return "serial"
+    if ns.executor == "dask":
+        try:
+            from dask.distributed import Client
+        except ImportError:
+            from .errors import ParameterError
+
+            raise ParameterError("--executor dask: dask.distributed is not installed (pip install 'rotorub[dask]')")
+        return Client(ns.dask_address).get_executor() if ns.dask_address else Client().get_executor()
+    return None
+
+
+@command("static", "balanced static solution with contact at one point, and its stability")
+@arg("--speed", type=float, default=3.3, help="normalised spin speed")
+@arg("--g0", type=float, default=0.8e-3, help="nominal clearance [m]")
+@arg("--formulation", default="3D", help="2D or 3D")
+def cmd_static(ns: argparse.Namespace) -> dict:
+    from .contact import make_contact
+    from .results import write_json
+    from .stability import stability_of
+    from .static import solve_static
+
+    m = _model(ns)
+    c = make_contact(m, ns.formulation, g0=ns.g0)
+    omega = ns.speed * m.params.normalisation.omega_ref
+    st = solve_static(m, c, omega)
+    s = {"speed": ns.speed, "formulation": ns.formulation, **st.summary()}
+    if st.converged:
+        s["stability"] = stability_of(m, c, omega, st.q).summary()
+    out = Path(ns.out)
+    out.mkdir(parents=True, exist_ok=True)
+    _plot_static(c, st, out / "static.png", f"{ns.formulation} static solution at Ω={ns.speed:g}, g0={ns.g0 * 1e3:g} mm")
+    write_json(out / "summary.json", s)
+    return s
+
+
+def _plot_static(contact, st, path: Path, title: str) -> None:
+    from .results import pyplot
+
+    plt = pyplot()
+    g = contact.gaps(st.q) * 1e3
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.6))
+    x = range(1, len(st.forces_N) + 1)
+    axes[0].bar(x, st.forces_N)
+    axes[0].set_xlabel("blade")
+    axes[0].set_ylabel("F_N [N]")
+    for k in range(g.shape[1]):
+        axes[1].plot(x, g[:, k], "o-", label=("LE", "TE")[k] if g.shape[1] == 2 else "tip")
+    axes[1].axhline(0, color="k", lw=0.8)
+    axes[1].set_xlabel("blade")
+    axes[1].set_ylabel("gap [mm]")
+    axes[1].legend()
+    fig.suptitle(title + ("" if st.converged else " — NOT CONVERGED"))
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _sweep_args(fn):
+    for a, k in (
+        (("--executor",), {"default": "process", "choices": ["process", "serial", "dask"],
+                           "help": "process pool on all cores, serial, or a Dask cluster"}),
+        (("--dask-address",), {"default": None, "help": "scheduler address (default: a local Dask cluster)"}),
+        (("--quick",), {"action": "store_true", "help": "coarse grid (40 x 30) instead of 100 x 100"}),
+    ):
+        fn = arg(*a, **k)(fn)
+    return fn
+
+
+@command("stability", "static-solution and stability maps over (speed, g0), 2D and 3D")
+@_sweep_args
+def cmd_stability(ns: argparse.Namespace) -> dict:
+    from .studies import run_stability_study
+
+    s = run_stability_study(_model(ns), ns.out, quick=ns.quick, executor=_executor(ns))
+    return {k: v for k, v in s.items() if not k.startswith("map_")}
+
+
+@command("transient", "2D and 3D central-difference transients (paper Fig. 12)")
+@arg("--speed", type=float, default=None, help="normalised spin speed (default: picked from the stability maps)")
+@arg("--g0", type=float, default=None, help="nominal clearance [m] (default: picked with the speed)")
+@arg("--t-end", type=float, default=4.0, help="simulated time [s] (imbalance ramped over the first second)")
+def cmd_transient(ns: argparse.Namespace) -> dict:
+    from .studies import run_transient_study
+
+    return run_transient_study(_model(ns), ns.out, ns.speed, ns.g0, t_end=ns.t_end)
+
+
 @command("reproduce", "main job: every analysis of the paper on one configuration, with a summary")
 @arg("--quick", action="store_true", help="coarse grids: a few minutes on 2 cores")
 def cmd_reproduce(ns: argparse.Namespace) -> dict:
@@ -108,7 +198,10 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"rotorub {ns.command}: interrupted", file=sys.stderr)
         return 130
-    print(json.dumps(result, default=float, indent=1)[:4000] if isinstance(result, dict) else result)
+    from .results import plain
+
+    text = json.dumps(plain(result), indent=1) if isinstance(result, dict) else str(result)
+    print(text if len(text) < 4000 else text[:4000] + "\n... (full result in --out)")
     return 0
 
 

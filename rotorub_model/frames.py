@@ -4,7 +4,7 @@ A component whose dofs come in (x, y) pairs, each pair the cos/sin amplitudes of
 field with n nodal diameters (n = 1 for translations and tilts), obeys in the fixed
 frame  M X'' + (C + Omega Gf) X' + K X = F  with M, C, K isotropic (M1 kron I2) and
 Gf = Gp kron [[0, 1], [-1, 0]].  With X = R(n Omega t) x this becomes, in the rotating
-frame,
+frame (X'' = R (x'' + 2 Omega S x' + Omega^2 S^2 x + dOmega/dt S x), S = n J),
 
     M x'' + (C + Omega (2n M1 - Gp) kron J) x'
           + (K + Omega n C1 kron J + Omega^2 (n Gp - n^2 M1) kron I) x = R^T F,
@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+MATRIX_KEYS = ("M", "D", "K", "G1", "C1", "N2", "S2", "E1")
 J2 = np.array([[0.0, -1.0], [1.0, 0.0]])
 I2 = np.eye(2)
 
@@ -40,10 +41,13 @@ class Matrices:
     C1: np.ndarray
     N2: np.ndarray
     S2: np.ndarray = field(default=None)  # type: ignore[assignment]
+    E1: np.ndarray = field(default=None)  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         if self.S2 is None:
             self.S2 = np.zeros_like(self.M)
+        if self.E1 is None:
+            self.E1 = np.zeros_like(self.M)
 
 
 def pair_names(prefix: str, labels: list[str]) -> list[str]:
@@ -63,6 +67,7 @@ def axisymmetric_to_rotating(
         G1=np.kron(2 * n * M1 - Gp, J2),
         C1=n * np.kron(C1, J2),
         N2=np.kron(n * Gp - n * n * M1, I2),
+        E1=n * np.kron(M1, J2),
     )
 
 
@@ -73,5 +78,5 @@ def block_diag(parts: list[Matrices]) -> Matrices:
     names = [d for p in parts for d in p.dofs]
     return Matrices(
         dofs=names,
-        **{k: bd(*[getattr(p, k) for p in parts]) for k in ("M", "D", "K", "G1", "C1", "N2", "S2")},
+        **{k: bd(*[getattr(p, k) for p in parts]) for k in MATRIX_KEYS},
     )

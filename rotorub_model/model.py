@@ -23,7 +23,7 @@ import numpy as np
 
 from .blades import bladed_disk_matrices
 from .casing import casing_matrices
-from .frames import Matrices
+from .frames import MATRIX_KEYS, Matrices
 from .params import Parameters, reference_parameters
 from .shaft import shaft_matrices, station_maps
 
@@ -44,7 +44,9 @@ class Model:
     C1: np.ndarray
     N2: np.ndarray
     S2: np.ndarray
+    E1: np.ndarray  # angular-acceleration (Euler) term: dOmega/dt E1 q
     f_unit: np.ndarray  # imbalance force for m e = 1 kg m at Omega = 1 rad/s
+    f_tangential: np.ndarray  # imbalance force for m e = 1 kg m at dOmega/dt = 1 rad/s^2
     slices: dict[str, slice]
 
     @property
@@ -58,10 +60,14 @@ class Model:
         """K(Omega) = K + Ks(Omega^2) + N(Omega) + C(Omega)."""
         return self.K + omega * omega * (self.S2 + self.N2) + omega * self.C1
 
-    def force(self, omega: float, me: float | None = None) -> np.ndarray:
-        """Imbalance force F(Omega^2) (constant in the rotating frame)."""
+    def force(self, omega: float, me: float | None = None, omega_dot: float = 0.0) -> np.ndarray:
+        """Imbalance force F(Omega^2) (constant in the rotating frame); with an angular
+        acceleration the imbalance also pulls tangentially (m e dOmega/dt)."""
         me = self.params.imbalance.me if me is None else me
-        return me * omega * omega * self.f_unit
+        f = me * omega * omega * self.f_unit
+        if omega_dot:
+            f = f + me * omega_dot * self.f_tangential
+        return f
 
     def index(self, name: str) -> int:
         return self.dofs.index(name)
@@ -85,7 +91,7 @@ class Model:
 
 
 def _place(n: int, parts: list[tuple[Matrices, np.ndarray]]) -> dict[str, np.ndarray]:
-    out = {k: np.zeros((n, n)) for k in ("M", "D", "K", "G1", "C1", "N2", "S2")}
+    out = {k: np.zeros((n, n)) for k in MATRIX_KEYS}
     for mats, idx in parts:
         ix = np.ix_(idx, idx)
         for k in out:
@@ -118,11 +124,14 @@ def build_model(params: Parameters | None = None) -> Model:
             (cs, np.arange(ns + nbt, n)),
         ],
     )
-    model = Model(params=p, dofs=dofs, f_unit=np.zeros(n), slices=slices, **mats)
+    model = Model(params=p, dofs=dofs, f_unit=np.zeros(n), f_tangential=np.zeros(n), slices=slices, **mats)
     T, _ = model.disk_maps
     ang = np.radians(p.imbalance.angle_deg)
     Ts, _ = station_maps(p, next(d for d in p.disks if d.name == p.imbalance.disk).z)
     f = np.zeros(n)
     f[slices["shaft"]] = Ts.T @ np.array([np.cos(ang), np.sin(ang), 0.0])
     model.f_unit = f
+    ft = np.zeros(n)
+    ft[slices["shaft"]] = Ts.T @ np.array([-np.sin(ang), np.cos(ang), 0.0])
+    model.f_tangential = ft
     return model

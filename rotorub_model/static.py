@@ -3,9 +3,14 @@
 Newton's method on R(q) = K(Omega) q - F_nl(q) - F with the analytic contact
 Jacobian and a backtracking line search on |R|. The contact forces are piecewise
 smooth (2D: piecewise linear), so a full Newton step can jump between contact
-states and cycle; the line search and, if that fails, a continuation in the
-imbalance (0 -> m e) get across the transitions. The result always says whether
-it converged and with what residual.
+states and cycle. Near the critical speed the contact stiffening bends the
+resonance (as a hardening Duffing oscillator): the solution branch followed by a
+continuation in g0 or in the imbalance can end at a fold, beyond which the
+equilibrium lies on another branch. So when Newton fails from the warm start, it
+is restarted from a set of candidates: the linear response, the responses with
+all contacts closed (full and half stiffness), scaled linear responses, and a
+continuation in the imbalance. The first converged one is returned; the result
+always says whether it converged and with what residual.
 
 Examples
 --------
@@ -84,6 +89,19 @@ def _newton(K: np.ndarray, F: np.ndarray, contact: ContactModel, q: np.ndarray, 
     return q, nr / scale, max_iter, nr <= tol * scale
 
 
+def _candidates(K, F, contact, q_lin, starts):
+    """Starting points, cheapest and most likely first (a generator: built lazily)."""
+    yield from starts
+    yield q_lin
+    from .transient import all_closed_stiffness
+
+    Kc = all_closed_stiffness(contact)
+    for frac in (1.0, 0.5, 0.1):
+        yield np.linalg.solve(K + frac * Kc, F)
+    for a in (0.5, 0.25, 1.5, 2.0):
+        yield a * q_lin
+
+
 def solve_static(
     model: Model,
     contact: ContactModel,
@@ -102,18 +120,27 @@ def solve_static(
     _check_omega(omega)
     K = model.K_omega(omega)
     F = model.force(omega, me)
-    if q0 is None:
-        q0 = np.linalg.solve(K, F)
-    q, rel, its, ok = _newton(K, F, contact, np.array(q0, dtype=float), tol, max_iter)
+    q_lin = np.linalg.solve(K, F)
+    starts = [q0] if q0 is not None else []
+    its_total = 0
+    best = None
+    for start in _candidates(K, F, contact, q_lin, starts):
+        q, rel, its, ok = _newton(K, F, contact, np.array(start, dtype=float), tol, max_iter)
+        its_total += its
+        if best is None or rel < best[1]:
+            best = (q, rel)
+        if ok:
+            break
     if not ok:
         q = np.zeros(model.n_dofs)
-        its_total = its
         for lam in np.linspace(0.1, 1.0, 10):
             q, rel, its, ok = _newton(K, lam * F, contact, q, tol, max_iter)
             its_total += its
             if not ok:
                 break
-        its = its_total
+        if not ok:
+            q, rel = best
+    its = its_total
     if not ok and raise_on_failure:
         raise ConvergenceError(
             f"static solution at omega={omega:g} rad/s, g0={contact.g0:g} m did not converge "

@@ -1,0 +1,232 @@
+"""The paper's section 5 and 6 studies, packaged: stability maps (2D and 3D) and the
+2D-vs-3D transient at a point where the 2D static solution is unstable and the 3D
+one stable.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .contact import make_contact
+from .errors import ParameterError
+from .maps import StabilityMap, run_stability_map
+from .model import Model
+from .results import pyplot, write_json
+from .stability import stability_of
+from .static import solve_static
+from .transient import TransientResult, run_transient
+
+PAPER_POINT = (3.3, 0.8e-3)  # the paper's transient point (normalised speed, g0 [m])
+
+
+def default_grid(model: Model, quick: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Speeds around the first critical and clearances up to its 3D closure."""
+    from .linear import run_response
+
+    r = run_response(model, n_speeds=800)
+    c1 = r.critical_speeds[0]
+    n_s, n_g = (40, 30) if quick else (100, 100)
+    speeds = np.linspace(max(c1 - 0.8, 0.05), c1 + 0.8, n_s)
+    gmax = 1.6 * r.peak_amplitudes[0]
+    return speeds, np.linspace(0.0, gmax, n_g)
+
+
+def run_stability_study(model: Model, out: str | Path, quick: bool = False, speeds=None, g0s=None,
+                        executor=None, progress: bool = True) -> dict:
+    """Maps for 2D and 3D; writes stability_{2D,3D}.png/.json/.npz and summary.json."""
+    out = Path(out)
+    if speeds is None or g0s is None:
+        speeds, g0s = default_grid(model, quick)
+    maps = {f: run_stability_map(model, f, speeds, g0s, executor=executor, out=out / "work", progress=progress)
+            for f in ("2D", "3D")}
+    s2, s3 = maps["2D"].save(out), maps["3D"].save(out)
+    _plot_pair(maps, out / "stability_maps.png")
+    summary = {
+        "unstable_fraction_2d": s2["unstable_fraction"],
+        "unstable_fraction_3d": s3["unstable_fraction"],
+        "stable_strip_3d": s3["stable_strip"],
+        "stable_strip_2d": s2["stable_strip"],
+        "max_blades_in_contact_2d": s2["max_blades_in_contact"],
+        "max_blades_in_contact_3d": s3["max_blades_in_contact"],
+        "no_equilibrium_points_2d": s2["no_equilibrium_points"],
+        "no_equilibrium_points_3d": s3["no_equilibrium_points"],
+        "grid": {"speeds": [float(speeds[0]), float(speeds[-1]), len(speeds)],
+                 "g0_mm": [float(g0s[0] * 1e3), float(g0s[-1] * 1e3), len(g0s)]},
+        "map_2d": s2,
+        "map_3d": s3,
+    }
+    write_json(out / "summary.json", summary)
+    return summary
+
+
+def _plot_pair(maps: dict[str, StabilityMap], path: Path) -> None:
+    plt = pyplot()
+    fig, axes = plt.subplots(2, 2, figsize=(11, 8), sharex=True, sharey=True)
+    for row, f in enumerate(("2D", "3D")):
+        m = maps[f]
+        X, Y = m.speeds, m.g0s * 1e3
+        nmax = max(int(m.n_contact.max()), 1)
+        a = axes[row, 0].pcolormesh(X, Y, np.where(m.contact, m.n_contact, np.nan).T, cmap="viridis",
+                                    vmin=0.5, vmax=nmax + 0.5, shading="nearest")
+        fig.colorbar(a, ax=axes[row, 0], label="blades in contact")
+        b = axes[row, 1].pcolormesh(X, Y, np.where(m.contact, m.sum_pos, np.nan).T, cmap="magma_r", shading="nearest")
+        fig.colorbar(b, ax=axes[row, 1], label="Σ Re(λ) > 0 [1/s]")
+        for ax in axes[row]:
+            ax.pcolormesh(X, Y, np.where(m.no_solution, 1.0, np.nan).T, cmap="Greys", vmin=0, vmax=2, shading="nearest")
+            ax.contour(X, Y, m.contact.T.astype(float), levels=[0.5], colors="k", linewidths=0.8)
+        axes[row, 0].set_ylabel(f"{f}: g0 [mm]")
+    axes[0, 0].set_title("contact configuration (blades in contact)")
+    axes[0, 1].set_title("stability: sum of positive real parts (white = stable)")
+    for ax in axes[1]:
+        ax.set_xlabel("normalised spin speed Ω / Ω_ref")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def point_status(model: Model, speed: float, g0: float) -> dict:
+    """Static solution and stability at one (normalised speed, g0) for 2D and 3D."""
+    omega = speed * model.params.normalisation.omega_ref
+    res = {}
+    for f in ("2D", "3D"):
+        c = make_contact(model, f, g0=g0)
+        st = solve_static(model, c, omega)
+        sb = stability_of(model, c, omega, st.q) if st.converged else None
+        res[f] = {"static": st, "stability": sb}
+    return res
+
+
+def pick_transient_point(model: Model, stab_dir: str | Path | None = None, quick: bool = True) -> tuple[float, float]:
+    """A point where the 2D static solution is unstable and the 3D one stable.
+
+    The paper's point (3.3, 0.8 mm) if it qualifies; otherwise, from the stability
+    maps, the qualifying cell with the most 2D blades in contact (3 preferred, as in
+    the paper), then closest to the paper's point.
+    """
+    st = point_status(model, *PAPER_POINT)
+    if _qualifies(st):
+        return PAPER_POINT
+    maps = {}
+    for f in ("2D", "3D"):
+        f_npz = Path(stab_dir) / f"stability_{f}.npz" if stab_dir else None
+        if f_npz is not None and f_npz.exists():
+            with np.load(f_npz) as z:
+                maps[f] = {k: z[k] for k in z.files}
+    if len(maps) < 2:
+        speeds, g0s = default_grid(model, quick=True)
+        for f in ("2D", "3D"):
+            m = run_stability_map(model, f, speeds, g0s, progress=False)
+            maps[f] = {"speeds": m.speeds, "g0s": m.g0s, "n_contact": m.n_contact, "max_real": m.max_real}
+    from .stability import RE_TOL
+
+    m2, m3 = maps["2D"], maps["3D"]
+    ok = (m2["n_contact"] > 0) & (m3["n_contact"] > 0) & (np.nan_to_num(m2["max_real"], nan=-1) > RE_TOL) & \
+         (np.nan_to_num(m3["max_real"], nan=1) <= RE_TOL)
+    idx = np.argwhere(ok)
+    if idx.size == 0:
+        raise ParameterError("transient point: no (speed, g0) on the map has an unstable 2D and a stable 3D "
+                             "static solution; give --speed and --g0 explicitly")
+    sp, g = m2["speeds"], m2["g0s"]
+
+    def score(ij):
+        i, j = ij
+        n2 = m2["n_contact"][i, j]
+        return (abs(n2 - 3), abs(sp[i] - PAPER_POINT[0]) + abs(g[j] - PAPER_POINT[1]) * 1e3)
+
+    i, j = min(map(tuple, idx), key=score)
+    return float(sp[i]), float(g[j])
+
+
+def _qualifies(st: dict) -> bool:
+    s2, s3 = st["2D"], st["3D"]
+    return bool(s2["static"].converged and s3["static"].converged and s2["static"].n_contact > 0
+                and s3["static"].n_contact > 0 and not s2["stability"].stable and s3["stability"].stable)
+
+
+@dataclass
+class TransientStudy:
+    speed: float
+    g0: float
+    runs: dict[str, TransientResult]
+    statics: dict
+
+    def summary(self) -> dict:
+        r2, r3 = self.runs["2D"], self.runs["3D"]
+        i2, i3 = r2.at_time(1.0), r3.at_time(1.0)
+        st3 = self.statics["3D"]["static"]
+        fr3 = r3.outputs["fraction"][i3]
+        touching = fr3[fr3 > 0]
+        partial = touching[touching < 1.0 - 1e-9]
+        return {
+            "speed": self.speed,
+            "g0_mm": self.g0 * 1e3,
+            "diverged_2d": r2.diverged,
+            "diverged_3d": r3.diverged,
+            "settled_3d": settled(r3, st3.q) if st3.converged else False,
+            "blades_in_contact_2d_at_1s": r2.blades_in_contact(i2),
+            "blades_in_contact_3d_at_1s": r3.blades_in_contact(i3),
+            "partial_chord_fraction_3d": float(partial.min()) if partial.size else (float(touching.min()) if touching.size else 0.0),
+            "chord_fractions_3d_at_1s": fr3,
+            "max_force_at_1s_N": {"2D": float(r2.outputs["F_N"][i2].max()), "3D": float(r3.outputs["F_N"][i3].max())},
+            "static_2d": {"blades_in_contact": self.statics["2D"]["static"].n_contact,
+                          "max_real_part": self.statics["2D"]["stability"].max_real if self.statics["2D"]["stability"] else None},
+            "static_3d": {"blades_in_contact": st3.n_contact, "chord_fractions": st3.fractions,
+                          "max_real_part": self.statics["3D"]["stability"].max_real if self.statics["3D"]["stability"] else None},
+            "messages": {"2D": r2.message, "3D": r3.message},
+        }
+
+    def plot(self, path: str | Path) -> Path:
+        plt = pyplot()
+        fig, axes = plt.subplots(1, 2, figsize=(12, 4.2), sharey=False)
+        for ax, f in zip(axes, ("2D", "3D")):
+            r = self.runs[f]
+            FN = r.outputs["F_N"]
+            for j in range(FN.shape[1]):
+                if FN[:, j].max() > 0:
+                    ax.plot(r.t, FN[:, j], lw=1, label=f"blade {j + 1}")
+            ax.axvline(1.0, color="k", lw=0.6, ls=":")
+            ax.set_title(f"{f}: normal contact forces" + (" — diverged" if r.diverged else ""))
+            ax.set_xlabel("time [s]")
+            ax.set_ylabel("F_N [N]")
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=7)
+        fig.suptitle(f"Ω = {self.speed:.3g}, g0 = {self.g0 * 1e3:.3g} mm (imbalance ramp over 1 s)")
+        fig.tight_layout()
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+        return Path(path)
+
+    def save(self, out: str | Path) -> dict:
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        for f, r in self.runs.items():
+            r.save(out, stem=f"transient_{f}")
+        self.plot(out / "contact_forces.png")
+        s = self.summary()
+        write_json(out / "summary.json", s)
+        return s
+
+
+def settled(run: TransientResult, q_static: np.ndarray, rel: float = 0.01) -> bool:
+    """Every dof within rel x its largest static value of the static solution at the end."""
+    if run.diverged or run.q.shape[0] == 0:
+        return False
+    err = np.abs(run.q[-1] - q_static)
+    return bool(np.all(err <= rel * np.max(np.abs(q_static))))
+
+
+def run_transient_study(model: Model, out: str | Path, speed: float | None = None, g0: float | None = None,
+                        t_end: float = 4.0, stab_dir: str | Path | None = None, progress: bool = True) -> dict:
+    """Paper section 6: 2D and 3D transients at one point; picks the point if not given."""
+    if (speed is None) != (g0 is None):
+        raise ParameterError("transient point: give both --speed and --g0, or neither (automatic choice)")
+    if speed is None:
+        speed, g0 = pick_transient_point(model, stab_dir)
+    omega = speed * model.params.normalisation.omega_ref
+    statics = point_status(model, speed, g0)
+    runs = {f: run_transient(model, make_contact(model, f, g0=g0), omega, t_end=t_end, progress=progress)
+            for f in ("2D", "3D")}
+    return TransientStudy(speed, g0, runs, statics).save(out)
