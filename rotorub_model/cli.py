@@ -83,7 +83,9 @@ def _executor(ns: argparse.Namespace):
         except ImportError:
             from .errors import ParameterError
 
-            raise ParameterError("--executor dask: dask.distributed is not installed (pip install 'rotorub[dask]')")
+            raise ParameterError(
+                "--executor dask: dask.distributed is not installed (pip install 'rotorub[dask]')"
+            ) from None
         return Client(ns.dask_address).get_executor() if ns.dask_address else Client().get_executor()
     return None
 
@@ -107,7 +109,8 @@ def cmd_static(ns: argparse.Namespace) -> dict:
         s["stability"] = stability_of(m, c, omega, st.q).summary()
     out = Path(ns.out)
     out.mkdir(parents=True, exist_ok=True)
-    _plot_static(c, st, out / "static.png", f"{ns.formulation} static solution at Ω={ns.speed:g}, g0={ns.g0 * 1e3:g} mm")
+    title = f"{ns.formulation} static solution at Ω={ns.speed:g}, g0={ns.g0 * 1e3:g} mm"
+    _plot_static(c, st, out / "static.png", title)
     write_json(out / "summary.json", s)
     return s
 

@@ -99,7 +99,7 @@ class ContactModel:
     def n_dofs(self) -> int:
         return self.G.shape[1]
 
-    def with_clearance(self, g0: float) -> "ContactModel":
+    def with_clearance(self, g0: float) -> ContactModel:
         """Same geometry, another nominal clearance (cheap: gaps are affine)."""
         return ContactModel(self.formulation, self.variant, self.geometry, g0, self.k_r, self.mu)
 

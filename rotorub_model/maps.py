@@ -110,6 +110,7 @@ class StabilityMap:
 
     def summary(self) -> dict:
         c = self.contact
+        b = self.boundary()
         return {
             "formulation": self.formulation,
             "unstable_fraction": self.unstable_fraction(),
@@ -117,7 +118,7 @@ class StabilityMap:
             "grid_points": int(c.size),
             "max_blades_in_contact": int(self.n_contact.max()),
             "stable_strip": self.stable_strip(),
-            "boundary_stable_fraction": float((~self.unstable[self.boundary()]).mean()) if self.boundary().any() else None,
+            "boundary_stable_fraction": float((~self.unstable[b]).mean()) if b.any() else None,
             "no_equilibrium_points": int(self.no_solution.sum()),
             "max_sum_positive_real": float(np.nanmax(self.sum_pos)) if np.isfinite(self.sum_pos).any() else 0.0,
         }

@@ -19,11 +19,12 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tomllib
 from dataclasses import dataclass, field, fields
 from importlib import resources
 from pathlib import Path
 from typing import Any
+
+import tomllib
 
 from .errors import ParameterError
 
@@ -156,7 +157,7 @@ class Parameters:
     contact: ContactParams
     normalisation: NormalisationParams
 
-    def replace(self, **sections: dict[str, Any]) -> "Parameters":
+    def replace(self, **sections: dict[str, Any]) -> Parameters:
         """Return a copy with some fields of some sections replaced, validated again.
 
         >>> p = reference_parameters().replace(contact={"g0": 1e-3})
@@ -283,7 +284,9 @@ def _check_consistency(p: Parameters) -> None:
             raise ParameterError(f"{group}: names must be unique, got {names}")
         for i, it in enumerate(items):
             if it.z > s.length:
-                raise ParameterError(f"{group}[{i}].z: {it.z:g} m out of range; accepted range [0, shaft.length={s.length:g}]")
+                raise ParameterError(
+                    f"{group}[{i}].z: {it.z:g} m out of range; accepted range [0, shaft.length={s.length:g}]"
+                )
     if len(p.bearings) == 1:
         raise ParameterError("bearings: two or more bearings are needed to hold the shaft (got 1)")
     if p.imbalance.disk not in [d.name for d in p.disks]:
@@ -293,7 +296,8 @@ def _check_consistency(p: Parameters) -> None:
     for d in p.disks:
         if d.Ip > 2 * d.Id * (1 + 1e-9):
             raise ParameterError(
-                f"disks[{d.name}].Ip: {d.Ip:g} kg m^2 violates the inertia triangle inequality; accepted range [0, 2*Id={2 * d.Id:g}]"
+                f"disks[{d.name}].Ip: {d.Ip:g} kg m^2 violates the inertia triangle inequality; "
+                f"accepted range [0, 2*Id={2 * d.Id:g}]"
             )
     b = p.blades
     if b.thickness > b.width:

@@ -41,7 +41,9 @@ class StabilityResult:
         }
 
 
-def stability_of(model: Model, contact: ContactModel, omega: float, q0: np.ndarray, n_dominant: int = 3) -> StabilityResult:
+def stability_of(
+    model: Model, contact: ContactModel, omega: float, q0: np.ndarray, n_dominant: int = 3
+) -> StabilityResult:
     """Eigen-analysis of the system linearised about the static solution q0."""
     A = first_order(model, omega, contact.jacobian(q0))
     lam, vec = np.linalg.eig(A)

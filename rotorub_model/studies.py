@@ -168,13 +168,13 @@ class TransientStudy:
             "settled_3d": settled(r3, st3.q) if st3.converged else False,
             "blades_in_contact_2d_at_1s": r2.blades_in_contact(i2),
             "blades_in_contact_3d_at_1s": r3.blades_in_contact(i3),
-            "partial_chord_fraction_3d": float(partial.min()) if partial.size else (float(touching.min()) if touching.size else 0.0),
+            "partial_chord_fraction_3d": _partial(partial, touching),
             "chord_fractions_3d_at_1s": fr3,
             "max_force_at_1s_N": {"2D": float(r2.outputs["F_N"][i2].max()), "3D": float(r3.outputs["F_N"][i3].max())},
             "static_2d": {"blades_in_contact": self.statics["2D"]["static"].n_contact,
-                          "max_real_part": self.statics["2D"]["stability"].max_real if self.statics["2D"]["stability"] else None},
+                          "max_real_part": _max_real(self.statics["2D"])},
             "static_3d": {"blades_in_contact": st3.n_contact, "chord_fractions": st3.fractions,
-                          "max_real_part": self.statics["3D"]["stability"].max_real if self.statics["3D"]["stability"] else None},
+                          "max_real_part": _max_real(self.statics["3D"])},
             "messages": {"2D": r2.message, "3D": r3.message},
         }
 
@@ -208,6 +208,17 @@ class TransientStudy:
         s = self.summary()
         write_json(out / "summary.json", s)
         return s
+
+
+def _partial(partial: np.ndarray, touching: np.ndarray) -> float:
+    """Smallest chord fraction among the partly touching blades (else among the touching ones)."""
+    if partial.size:
+        return float(partial.min())
+    return float(touching.min()) if touching.size else 0.0
+
+
+def _max_real(status: dict) -> float | None:
+    return status["stability"].max_real if status["stability"] is not None else None
 
 
 def settled(run: TransientResult, q_static: np.ndarray, rel: float = 0.01) -> bool:

@@ -56,7 +56,7 @@ def _cd_segment(q_prev, q, n_steps, Ainv, K2, Cm1, f_imb, t0, dt, t_ramp, me_rat
     n_rec = rec_start
     for i in range(n_steps):
         t = t0 + i * dt
-        r = t / t_ramp if t < t_ramp else 1.0
+        r = 1.0 if (t_ramp <= 0.0 or t >= t_ramp) else t / t_ramp
         r *= me_ratio0
         # gaps and contact law
         for row in range(nb * n_pts):
@@ -147,7 +147,7 @@ class CentralDifference:
         if not math.isfinite(max_penetration) or max_penetration <= 0:
             raise ParameterError(f"max_penetration: {max_penetration} out of range; accepted range (0, inf) m")
         self.model, self.contact = model, contact
-        self.t_ramp = max(t_ramp, 1e-300)
+        self.t_ramp = float(t_ramp)
         self.max_penetration = max_penetration
         self.user_dt = dt
         w = omega_max_for_dt if omega_max_for_dt is not None else 0.0
@@ -388,6 +388,9 @@ def run_transient(
     if not np.all(np.isfinite(speeds)) or np.any(speeds < 0):
         raise ParameterError("omega: spin speed must be finite and >= 0 rad/s over the whole run")
     integ = CentralDifference(model, contact, dt, t_ramp, max_penetration, omega_max_for_dt=float(speeds.max()))
+    if dt is None and record_dt > integ.dt:
+        # automatic step: shrink it so the records fall exactly on multiples of record_dt
+        integ.dt = record_dt / math.ceil(record_dt / integ.dt)
     dt_ = integ.dt
     if q0 is not None:
         integ.q[:] = q0
