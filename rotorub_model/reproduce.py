@@ -33,11 +33,16 @@ def run_reproduce(model: Model, out: str | Path, quick: bool = False) -> dict:
     resp = run_response(model, n_speeds=600 if quick else 2000).save(out / "response")
     run_modes(model, resp["critical_speeds"][0]).save(out / "modes")
     run_campbell(model, n_speeds=25 if quick else 80).save(out / "campbell")
+    from .detection import paper_facts as detection_facts
+    from .detection import run_detection
+
+    det = run_detection(model, n_speeds=200 if quick else 400).save(out / "detection")
     summary = {
         "n_dofs": model.n_dofs,
         "omega_ref_rad_s": model.params.normalisation.omega_ref,
         "response": resp,
-        "paper_facts": [fact1(resp)],
+        "detection": det,
+        "paper_facts": [fact1(resp), *detection_facts(det)],
     }
     write_json(out / "summary.json", summary)
     return summary
