@@ -18,6 +18,8 @@ T = 1/2 sum dm |r' + Omega e_z x r|^2 expanded to second order in q gives
 * Ks = -Omega^2 sum dm rho0 . d2r/dq2     (stress stiffening: foreshortening against
   the centrifugal field, plus the centrifugal coupling of disk tilt with blade and
   with the blade ring's own inertia),
+* E1 = sum dm [J^T Z J + (Z rho0) . d2r/dq2] and the load -sum dm J^T Z rho0, both
+  multiplied by dOmega/dt (Euler force of a changing spin speed),
 
 and the elastic energy V = 1/2 int E I v''^2 ds gives K. The rigid part of the
 blades (their mass and inertia carried by the disk) comes out of the same sums,
@@ -88,6 +90,8 @@ def bladed_disk_matrices(p: Parameters, n_quad: int | None = None) -> Matrices:
     S2 = np.zeros((n, n))
     K = np.zeros((n, n))
     D = np.zeros((n, n))
+    E1 = np.zeros((n, n))
+    f_euler = np.zeros(n)
     for j, alpha in enumerate(blade_angles(p)):
         e_r, e_t, _, nv = blade_frame(alpha, beta)
         sl = slice(ns + j * nb, ns + (j + 1) * nb)
@@ -105,14 +109,26 @@ def bladed_disk_matrices(p: Parameters, n_quad: int | None = None) -> Matrices:
             N2 -= dm * Jg.T @ P @ Jg
             Q = np.zeros((n, n))
             Q[:ns, :ns] = Rm.T @ (np.outer(rho0, rho0) - R * R * np.eye(3)) @ Rm
-            X = -R * np.sin(beta) * np.outer(Rm.T @ e_t, psi[g])
+            # rho0 . (theta x v n) = v theta . (n x rho0) = R sin(beta) (theta . e_t) v
+            X = R * np.sin(beta) * np.outer(Rm.T @ e_t, psi[g])
             Q[:ns, sl] += X
             Q[sl, :ns] += X.T
             Q[sl, sl] += -R * fs[g]
             S2 -= dm * Q
+            # Euler term: d/dt(dr/dq . Omega Z r) gives dOmega/dt [J^T Z J + (Z r0) . d2r/dq2] q plus the
+            # load -dOmega/dt J^T Z r0; (Z r0) = R e_t: tilt-tilt part R^2 sym(e_t e_r^T) and
+            # e_t . (theta x v n) = -sin(beta) (theta . e_r) v
+            Hz = np.zeros((n, n))
+            Hz[:ns, :ns] = R * R * Rm.T @ (0.5 * (np.outer(e_t, e_r) + np.outer(e_r, e_t))) @ Rm
+            Y = -R * np.sin(beta) * np.outer(Rm.T @ e_r, psi[g])
+            Hz[:ns, sl] += Y
+            Hz[sl, :ns] += Y.T
+            E1 += dm * (Jg.T @ Z @ Jg + Hz)
+            f_euler -= dm * Jg.T @ (Z @ rho0)
     names = [f"shaft.a{i}.{c}" for i in range(p.shaft.n_ritz) for c in ("x", "y")] + blade_dof_names(p)
-    # Euler force: d/dt (dm Omega e_z x r) . dr/dq gives dOmega/dt sum dm J^T Z J q = G1 / 2
-    return Matrices(dofs=names, M=M, D=D, K=K, G1=G1, C1=np.zeros((n, n)), N2=N2, S2=S2, E1=0.5 * G1)
+    mats = Matrices(dofs=names, M=M, D=D, K=K, G1=G1, C1=np.zeros((n, n)), N2=N2, S2=S2, E1=E1)
+    mats.f_euler = f_euler  # load per unit angular acceleration (blades lag when the spin speeds up)
+    return mats
 
 
 def blade_tip_map(p: Parameters, j: int) -> np.ndarray:

@@ -160,7 +160,7 @@ def cmd_stability(ns: argparse.Namespace) -> dict:
 @command("transient", "2D and 3D central-difference transients (paper Fig. 12)")
 @arg("--speed", type=float, default=None, help="normalised spin speed (default: picked from the stability maps)")
 @arg("--g0", type=float, default=None, help="nominal clearance [m] (default: picked with the speed)")
-@arg("--t-end", type=float, default=4.0, help="simulated time [s] (imbalance ramped over the first second)")
+@arg("--t-end", type=float, default=20.0, help="simulated time [s] (imbalance ramped over the first second)")
 def cmd_transient(ns: argparse.Namespace) -> dict:
     from .studies import run_transient_study
 
@@ -195,8 +195,15 @@ def cmd_reproduce(ns: argparse.Namespace) -> dict:
     return {"paper_facts": s["paper_facts"], "written": str(Path(ns.out) / "summary.json")}
 
 
+class _OneLineParser(argparse.ArgumentParser):
+    """argparse that reports a bad argument on one line (no usage dump)."""
+
+    def error(self, message: str):  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="rotorub", description=__doc__.splitlines()[0])
+    ap = _OneLineParser(prog="rotorub", description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="command", required=True)
     for name, (help_text, add_args, _) in COMMANDS.items():
         sp = sub.add_parser(name, help=help_text)

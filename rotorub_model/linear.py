@@ -155,9 +155,12 @@ def first_order(model: Model, omega: float, K_extra: np.ndarray | None = None) -
 def harmonic_weights(model: Model, phi: np.ndarray) -> dict[int, float]:
     """Share of the mode shape phi (rotating frame, complex) in each nodal-diameter index m.
 
-    The pair (x, y) of harmonic n holds u(a) = x cos(n a) + y sin(n a): index +n gets
-    |x - i y|^2 / 4 and -n gets |x + i y|^2 / 4 (weighted by the pair's mass). Blade
-    dofs are transformed by a discrete Fourier transform over the blades.
+    The pair (x, y) of harmonic n holds u(a) = x cos(n a) + y sin(n a). With time
+    dependence exp(+i w t), a forward wave (turning with +a, e.g. x = cos, y = sin:
+    phi = (1, -i)) has |x + i y| and no |x - i y|: index +n gets |x + i y|^2 / 4,
+    -n gets |x - i y|^2 / 4 (weighted by the pair's mass). Blade dofs go through a
+    DFT over the blades: the coefficient of exp(+i k a_j) times exp(+i w t) is a
+    wave turning with -a, index -k.
     """
     w: dict[int, float] = {}
     Md = np.diag(model.M)
@@ -167,15 +170,15 @@ def harmonic_weights(model: Model, phi: np.ndarray) -> dict[int, float]:
         n = int(name.split(".")[1][1:]) if name.startswith("casing.n") else 1
         x, y = phi[i], phi[i + 1]
         m = Md[i]
-        w[n] = w.get(n, 0.0) + m * abs(x - 1j * y) ** 2 / 4
-        w[-n] = w.get(-n, 0.0) + m * abs(x + 1j * y) ** 2 / 4
+        w[n] = w.get(n, 0.0) + m * abs(x + 1j * y) ** 2 / 4
+        w[-n] = w.get(-n, 0.0) + m * abs(x - 1j * y) ** 2 / 4
     p = model.params
     N, nb = p.blades.count, p.blades.n_ritz
     bl = phi[model.slices["blades"]].reshape(N, nb)
     mb = Md[model.slices["blades"]].reshape(N, nb)[0]
     coef = np.fft.fft(bl, axis=0) / N  # coef[k] multiplies exp(+i k a_j)
     for k in range(N):
-        m_idx = k if k <= N // 2 else k - N
+        m_idx = -(k if k <= N // 2 else k - N)
         w[m_idx] = w.get(m_idx, 0.0) + float(np.sum(mb * np.abs(coef[k]) ** 2)) * N
     return w
 

@@ -92,9 +92,22 @@ class StabilityMap:
     def no_solution(self) -> np.ndarray:
         return self.n_contact < 0
 
+    def cell_areas(self) -> np.ndarray:
+        """Area of each cell in the (speed, g0) plane: fractions are of the contact AREA,
+        whatever the grid spacing (the quick grid is denser at small g0)."""
+
+        def widths(x: np.ndarray) -> np.ndarray:
+            if x.size == 1:
+                return np.ones(1)
+            e = np.concatenate([[x[0]], 0.5 * (x[1:] + x[:-1]), [x[-1]]])
+            return np.diff(e)
+
+        return np.outer(widths(self.speeds), widths(self.g0s))
+
     def unstable_fraction(self) -> float:
         c = self.contact
-        return float((self.unstable & c).sum() / max(c.sum(), 1))
+        a = self.cell_areas()
+        return float(a[self.unstable & c].sum() / max(a[c].sum(), 1e-300))
 
     def boundary(self) -> np.ndarray:
         c = self.contact
@@ -131,8 +144,10 @@ class StabilityMap:
         im0 = axes[0].pcolormesh(X, Y, np.where(self.contact, self.n_contact, np.nan).T, cmap="viridis",
                                  vmin=0.5, vmax=nmax + 0.5, shading="nearest")
         fig.colorbar(im0, ax=axes[0], label="blades in contact", ticks=range(1, nmax + 1))
-        val = np.where(self.contact, self.sum_pos, np.nan).T
-        im1 = axes[1].pcolormesh(X, Y, val, cmap="magma_r", shading="nearest")
+        axes[1].pcolormesh(X, Y, np.where(self.contact & ~self.unstable, 1.0, np.nan).T, cmap="Greens", vmin=0, vmax=4,
+                           shading="nearest")
+        val = np.where(self.contact & self.unstable, self.sum_pos, np.nan).T
+        im1 = axes[1].pcolormesh(X, Y, val, cmap="inferno_r", shading="nearest")
         fig.colorbar(im1, ax=axes[1], label="sum of positive real parts [1/s]")
         for ax in axes:
             grey = np.where(self.no_solution, 1.0, np.nan).T
@@ -142,7 +157,7 @@ class StabilityMap:
             ax.grid(alpha=0.2)
         axes[0].set_ylabel("initial clearance g0 [mm]")
         axes[0].set_title(f"{self.formulation}: contact configuration")
-        axes[1].set_title(f"{self.formulation}: stability (white = stable, grey = no equilibrium)")
+        axes[1].set_title(f"{self.formulation}: stability (green = stable, grey = no equilibrium)")
         fig.tight_layout()
         fig.savefig(path, dpi=120)
         plt.close(fig)

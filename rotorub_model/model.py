@@ -47,6 +47,7 @@ class Model:
     E1: np.ndarray  # angular-acceleration (Euler) term: dOmega/dt E1 q
     f_unit: np.ndarray  # imbalance force for m e = 1 kg m at Omega = 1 rad/s
     f_tangential: np.ndarray  # imbalance force for m e = 1 kg m at dOmega/dt = 1 rad/s^2
+    f_euler: np.ndarray  # inertia load of the blades at dOmega/dt = 1 rad/s^2
     slices: dict[str, slice]
 
     @property
@@ -62,11 +63,12 @@ class Model:
 
     def force(self, omega: float, me: float | None = None, omega_dot: float = 0.0) -> np.ndarray:
         """Imbalance force F(Omega^2) (constant in the rotating frame); with an angular
-        acceleration the imbalance also pulls tangentially (m e dOmega/dt)."""
+        acceleration the imbalance also pulls tangentially (m e dOmega/dt) and the
+        blades carry their inertia load (they lag when the spin speeds up)."""
         me = self.params.imbalance.me if me is None else me
         f = me * omega * omega * self.f_unit
         if omega_dot:
-            f = f + me * omega_dot * self.f_tangential
+            f = f + omega_dot * (me * self.f_tangential + self.f_euler)
         return f
 
     def index(self, name: str) -> int:
@@ -124,7 +126,9 @@ def build_model(params: Parameters | None = None) -> Model:
             (cs, np.arange(ns + nbt, n)),
         ],
     )
-    model = Model(params=p, dofs=dofs, f_unit=np.zeros(n), f_tangential=np.zeros(n), slices=slices, **mats)
+    model = Model(params=p, dofs=dofs, f_unit=np.zeros(n), f_tangential=np.zeros(n), f_euler=np.zeros(n),
+                  slices=slices, **mats)
+    model.f_euler[slices["rotor"]] = bd.f_euler
     T, _ = model.disk_maps
     ang = np.radians(p.imbalance.angle_deg)
     Ts, _ = station_maps(p, next(d for d in p.disks if d.name == p.imbalance.disk).z)

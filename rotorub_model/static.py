@@ -17,7 +17,7 @@ Examples
 >>> from rotorub_model.model import build_model
 >>> from rotorub_model.contact import make_contact
 >>> m = build_model()
->>> r = solve_static(m, make_contact(m, "3D", g0=0.8e-3), 3.3 * 53.4)
+>>> r = solve_static(m, make_contact(m, "3D", g0=0.2e-3), 3.3 * 53.4)
 >>> r.converged, r.n_contact
 (True, 3)
 """
