@@ -370,15 +370,28 @@ def run_transient(
     v0: np.ndarray | None = None,
     max_penetration: float = 0.01,
     progress: bool = False,
+    hold: float | None = None,
 ) -> TransientResult:
     """Central-difference transient from rest (or q0, v0), imbalance ramped over t_ramp.
 
     ``omega`` is a constant [rad/s] or a function of time (a spin-speed history).
     Records every ``record_dt`` seconds (rounded to whole steps).
+
+    ``hold`` [s] reproduces what a co-simulation master does with the FMU: the inputs
+    (spin speed and ramped imbalance) are sampled at the start of each interval of
+    length ``hold`` and held over it (zero-order hold, Euler terms off), and the step
+    is the largest that divides ``hold`` within the stability cap. ``record_dt`` must
+    then be a whole multiple of ``hold``.
     """
     for name, v, lo in (("t_end", t_end, 0.0), ("record_dt", record_dt, 0.0), ("segment", segment, 0.0)):
         if not math.isfinite(v) or v <= lo:
             raise ParameterError(f"{name}: {v} out of range; accepted range ({lo:g}, inf) s")
+    if hold is not None:
+        if not math.isfinite(hold) or hold <= 0:
+            raise ParameterError(f"hold: {hold} out of range; accepted range (0, inf) s")
+        ratio = record_dt / hold
+        if abs(ratio - round(ratio)) > 1e-9 * ratio or round(ratio) < 1:
+            raise ParameterError(f"record_dt: {record_dt} s must be a whole multiple of hold = {hold} s")
     me = model.params.imbalance.me if me is None else me
     if not math.isfinite(me) or me < 0:
         raise ParameterError(f"me: {me} out of range; accepted range [0, inf) kg m")
@@ -387,8 +400,12 @@ def run_transient(
     speeds = np.array([omega_fn(t) for t in ts])
     if not np.all(np.isfinite(speeds)) or np.any(speeds < 0):
         raise ParameterError("omega: spin speed must be finite and >= 0 rad/s over the whole run")
-    integ = CentralDifference(model, contact, dt, t_ramp, max_penetration, omega_max_for_dt=float(speeds.max()))
-    if dt is None and record_dt > integ.dt:
+    integ = CentralDifference(model, contact, dt, 0.0 if hold else t_ramp, max_penetration,
+                              omega_max_for_dt=float(speeds.max()))
+    if hold is not None:
+        # same rule as the FMU: n = ceil(h / cap) substeps per held interval
+        integ.dt = hold / max(1, math.ceil(hold / integ.dt * (1 - 1e-9)))
+    elif dt is None and record_dt > integ.dt:
         # automatic step: shrink it so the records fall exactly on multiples of record_dt
         integ.dt = record_dt / math.ceil(record_dt / integ.dt)
     dt_ = integ.dt
@@ -401,6 +418,9 @@ def run_transient(
     rec_q = np.zeros((n_rec, model.n_dofs))
     constant = not callable(omega)
     seg_steps = n_total if constant else max(1, int(round(segment / dt_)))
+    if hold is not None:
+        seg_steps = max(1, int(round(hold / dt_)))
+    phi_rec = []
     done_total, written = 0, 0
     bar = None
     if progress:
@@ -410,9 +430,17 @@ def run_transient(
     while done_total < n_total:
         n = min(seg_steps, n_total - done_total)
         t_a, t_b = integ.t, integ.t + n * dt_
-        w_mid = omega_fn(0.5 * (t_a + t_b))
-        w_dot = 0.0 if constant else (omega_fn(t_b) - omega_fn(t_a)) / (t_b - t_a)
-        done, written = integ.advance(n, w_mid, me, w_dot, rec_every=rec_every, rec_q=rec_q, rec_start=written)
+        if hold is not None:
+            w_mid, w_dot = omega_fn(t_a), 0.0
+            me_k = me * (1.0 if (t_ramp <= 0 or t_a >= t_ramp) else t_a / t_ramp)
+        else:
+            w_mid = omega_fn(0.5 * (t_a + t_b))
+            w_dot = 0.0 if constant else (omega_fn(t_b) - omega_fn(t_a)) / (t_b - t_a)
+            me_k = me
+        before = written
+        done, written = integ.advance(n, w_mid, me_k, w_dot, rec_every=rec_every, rec_q=rec_q, rec_start=written)
+        if hold is not None and written > before:
+            phi_rec.append(integ.phi)
         done_total += done
         if bar is not None:
             bar.update(done)
@@ -423,7 +451,10 @@ def run_transient(
     t_rec = (np.arange(written) + 1) * rec_every * dt_
     q_rec = rec_q[:written]
     om = np.array([omega_fn(t) for t in t_rec])
-    if constant or written == 0:
+    if hold is not None:
+        phi = np.array(phi_rec[:written])
+        om = np.array([omega_fn(t - hold) for t in t_rec])  # the speed held over the last interval
+    elif constant or written == 0:
         phi = om * t_rec
     else:  # frame angle: trapezoidal integral of the spin-speed history
         phi = om[0] * t_rec[0] + np.concatenate([[0.0], np.cumsum(0.5 * (om[1:] + om[:-1]) * np.diff(t_rec))])

@@ -1,0 +1,238 @@
+"""Build fmus/RotorCasingContact.fmu from the slave script and a copy of the library.
+
+    rotorub build-fmu [--params my.toml] [--out fmus]      (or: python fmu_src/build.py [DEST])
+
+The FMU carries, in its resources folder:
+
+* ``rotorub_casing_contact_<h>.py``: the pythonfmu slave (fmu_src/rotorub_casing_contact.py);
+* ``rotorub_model_<h>/``: a verbatim copy of the ``rotorub_model`` sources and data;
+* ``reference.toml``: the parameter file used when the ``param_file`` parameter is empty
+  (the embedded reference, or the file given with --params);
+* ``rotorub_fmu.json``: which package/parameter file to load and the number of blades;
+* ``requirements.txt``: what the host Python needs (``pythonfmu deploy`` can install it);
+* ``pythonfmu/``: pythonfmu's Python side (added by pythonfmu's builder).
+
+``<h>`` is a hash of everything above: every pythonfmu FMU in a process shares one
+interpreter and one ``sys.modules``, so two different builds (or another FMU built
+from this library) never load each other's modules, while two copies of the same
+build share them harmlessly. The library copy is imported under that name through
+relative imports only; the build refuses sources that import ``rotorub_model`` by
+its absolute name.
+"""
+
+from __future__ import annotations
+
+import ast
+import hashlib
+import html
+import json
+import shutil
+import sys
+import tempfile
+import zipfile
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent
+SCRIPT = HERE / "rotorub_casing_contact.py"
+LIB = REPO / "rotorub_model"
+MODEL_IDENTIFIER = "RotorCasingContact"
+HOST_REQUIREMENTS = ["numpy>=1.26", "scipy>=1.11", "numba>=0.59"]
+
+
+class BuildError(Exception):
+    pass
+
+
+def _library_files() -> list[Path]:
+    files = [p for p in sorted(LIB.rglob("*")) if p.is_file() and "__pycache__" not in p.parts
+             and p.suffix in (".py", ".toml")]
+    if not (LIB / "__init__.py").exists():
+        raise BuildError(f"library sources not found in {LIB}")
+    return files
+
+
+def _check_relative_only(path: Path, text: str) -> str:
+    """The copy is imported under another name: no absolute import of rotorub_model may remain."""
+    tree = ast.parse(text, str(path))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import) and any(a.name.split(".")[0] == "rotorub_model" for a in node.names):
+            raise BuildError(f"{path}:{node.lineno}: absolute import of rotorub_model; the FMU's copy needs "
+                             "relative imports")
+        absolute_from = isinstance(node, ast.ImportFrom) and node.level == 0
+        if absolute_from and (node.module or "").split(".")[0] == "rotorub_model":
+            raise BuildError(f"{path}:{node.lineno}: absolute import of rotorub_model; the FMU's copy needs "
+                             "relative imports")
+    # resources.files("rotorub_model") (the embedded reference) -> the copy's own package
+    return text.replace('resources.files("rotorub_model")', "resources.files(__package__)")
+
+
+def _documentation(doc: Path, manifest: dict, variables: list[tuple]) -> None:
+    doc.mkdir(parents=True, exist_ok=True)
+    rows = "\n".join(
+        f"<tr><td><code>{html.escape(n)}</code></td><td>{c}</td><td>{html.escape(u or '')}</td>"
+        f"<td>{html.escape(d)}</td></tr>"
+        for n, _k, c, _v, u, d in variables
+    )
+    req = "".join(f"<li><code>{html.escape(r)}</code></li>" for r in HOST_REQUIREMENTS)
+    (doc / "index.html").write_text(f"""<!DOCTYPE html>
+<html><head><meta charset="utf-8"><title>{MODEL_IDENTIFIER}</title></head><body>
+<h1>{MODEL_IDENTIFIER} &mdash; blade-tip / casing contact FMU (FMI 2.0 co-simulation)</h1>
+<p>Bladed fan rotor and flexible casing in the rotating frame (Parent, Thouverez &amp; Chevillot,
+EURODYN 2014), wrapped from the <code>rotorub_model</code> library {html.escape(manifest['library_version'])}
+whose sources travel inside the FMU (<code>resources/{html.escape(manifest['library'])}</code>), with the
+parameter file <code>resources/{html.escape(manifest['parameters'])}</code> ({manifest['n_blades']} blades).</p>
+<h2>What the host needs</h2>
+<p>This is a <a href="https://github.com/NTNU-IHB/PythonFMU">pythonfmu</a> FMU: its shared library embeds
+the CPython interpreter of the host and does <b>not</b> link libpython.</p>
+<ul>
+<li>CPython 3.10 or newer, 64-bit (Linux: a shared <code>libpython3.X.so</code>), with these packages
+importable ({html.escape('resources/requirements.txt')}; <code>pythonfmu deploy</code> installs them):
+<ul>{req}</ul>
+numba is required: the bundled library compiles its contact law and transient loop with it (first step of a
+process: a few seconds of JIT compilation, cached next to the extracted sources when writable).
+pythonfmu itself is carried in <code>resources/pythonfmu</code>; rotorub does not need to be installed.</li>
+<li>A Python master (fmpy, ecospy, ...) running in that Python: nothing else to do.</li>
+<li>A native master (C/C++ system simulator): load <code>libpython3.X.so</code> with
+<code>RTLD_GLOBAL</code> before the FMU's <code>binaries/linux64/{MODEL_IDENTIFIER}.so</code> (e.g.
+<code>LD_PRELOAD=/path/to/libpython3.11.so</code>), and set <code>PYTHONHOME</code> to the Python's
+prefix and <code>PYTHONPATH</code> to the site-packages holding numpy, scipy, numba (e.g. a virtualenv's).
+See docs/FMU.md in the repository for a worked example.</li>
+</ul>
+<h2>Behaviour</h2>
+<ul>
+<li>Inputs are held constant over each communication step (zero-order hold; no input interpolation).
+Variable communication step sizes are accepted.</li>
+<li><code>mode = "transient"</code>: central differences; each step h is split into n = ceil(h / dt_cap)
+equal substeps, dt_cap = min(dt_max, half the stability limit 2/w_max at the current speed). When h/n
+changes, the scheme restarts at the same velocity.</li>
+<li><code>mode = "quasi_static"</code>: each step returns the balanced static solution at the current inputs,
+warm-started from the previous one, and the largest real part of the linearised eigenvalues.</li>
+<li>fmi2GetFMUstate / fmi2SetFMUstate / serialization restore the full solver state (rollback);
+fmi2Reset returns to the instantiated state.</li>
+<li>Bad input (NaN or negative spin speed or imbalance, unknown mode or formulation, dt_max &lt;= 0,
+unreadable parameter file) and divergence make fmi2DoStep return fmi2Discard after a log message
+(status fmi2Error or fmi2Discard) that names the cause; the <code>status</code> output says 2 (bad input)
+or 1 (diverged). The instance stays usable: corrected inputs, fmi2SetFMUstate or fmi2Reset.</li>
+</ul>
+<h2>Variables</h2>
+<table border="1" cellspacing="0" cellpadding="3">
+<tr><th>name</th><th>causality</th><th>unit</th><th>description</th></tr>
+{rows}
+</table>
+</body></html>
+""")
+    fmu_md = REPO / "docs" / "FMU.md"
+    if fmu_md.exists():
+        shutil.copy2(fmu_md, doc / "FMU.md")
+
+
+def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None) -> dict:
+    """Build ``dest/RotorCasingContact.fmu``; returns a summary dict. Needs pythonfmu."""
+    try:
+        from pythonfmu import FmuBuilder
+        from pythonfmu import __version__ as pythonfmu_version
+    except ImportError:
+        raise BuildError("pythonfmu is not installed: pip install 'rotorub[fmu]'") from None
+    sys.path.insert(0, str(REPO))
+    try:
+        from rotorub_model import __version__ as lib_version
+        from rotorub_model.params import load_parameters
+    finally:
+        sys.path.remove(str(REPO))
+    params_path = Path(params_file) if params_file else LIB / "data" / "reference.toml"
+    params = load_parameters(params_path)  # validated now, not in the master
+    dest = Path(dest)
+    dest.mkdir(parents=True, exist_ok=True)
+
+    files = _library_files()
+    h = hashlib.sha256()
+    for p in [SCRIPT, params_path, *files]:
+        h.update(str(p.relative_to(REPO) if p.is_relative_to(REPO) else p.name).encode())
+        h.update(p.read_bytes())
+    h.update(pythonfmu_version.encode())
+    tag = h.hexdigest()[:10]
+    lib_name = f"rotorub_model_{tag}"
+    module_name = f"rotorub_casing_contact_{tag}"
+    manifest = {"library": lib_name, "library_version": lib_version, "parameters": "reference.toml",
+                "n_blades": params.blades.count, "build": tag, "pythonfmu": pythonfmu_version,
+                "host_requirements": HOST_REQUIREMENTS}
+
+    added_modules = set()
+    before = set(sys.modules)
+    path_before = list(sys.path)
+    with tempfile.TemporaryDirectory(prefix="rotorub_fmu_") as tmp:
+        stage = Path(tmp) / "stage"
+        stage.mkdir()
+        pkg = stage / lib_name
+        for p in files:
+            rel = p.relative_to(LIB)
+            out = pkg / rel
+            out.parent.mkdir(parents=True, exist_ok=True)
+            if p.suffix == ".py":
+                out.write_text(_check_relative_only(p, p.read_text()))
+            else:
+                shutil.copy2(p, out)
+        shutil.copy2(params_path, stage / "reference.toml")
+        (stage / "rotorub_fmu.json").write_text(json.dumps(manifest, indent=1))
+        (stage / "requirements.txt").write_text("\n".join(HOST_REQUIREMENTS) + "\n")
+        script = stage / f"{module_name}.py"
+        shutil.copy2(SCRIPT, script)
+        spec_vars = _variables(stage, module_name)
+        _documentation(Path(tmp) / "documentation", manifest, spec_vars)
+        out_file = dest / f"{MODEL_IDENTIFIER}.fmu"
+        try:
+            FmuBuilder.build_FMU(
+                script, dest=out_file,
+                project_files=[pkg, stage / "reference.toml", stage / "rotorub_fmu.json", stage / "requirements.txt"],
+                documentation_folder=Path(tmp) / "documentation",
+                canGetAndSetFMUstate=True, canSerializeFMUstate=True,
+            )
+        finally:
+            # the builder imports the script (and through it the library copy) into this process
+            # and leaves its folders on sys.path: undo that, the folders are about to disappear
+            added_modules = set(sys.modules) - before
+            for m in added_modules:
+                if m.split(".")[0] in (module_name, lib_name, f"_doc_{module_name}"):
+                    sys.modules.pop(m, None)
+            sys.path[:] = path_before
+    with zipfile.ZipFile(out_file) as z:
+        names = z.namelist()
+        md = z.read("modelDescription.xml").decode()
+    return {"fmu": str(out_file), "size_bytes": out_file.stat().st_size, "files": len(names),
+            "variables": md.count("<ScalarVariable"), "blades": params.blades.count, "build": tag,
+            "parameters": str(params_path), "host_requirements": HOST_REQUIREMENTS}
+
+
+def _variables(stage: Path, module_name: str) -> list[tuple]:
+    """The variable table of the slave (for the documentation), read by instantiating it."""
+    import importlib.util
+
+    sys.path.insert(0, str(stage))
+    try:
+        spec = importlib.util.spec_from_file_location(f"_doc_{module_name}", stage / f"{module_name}.py")
+        mod = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)
+        inst = mod.RotorCasingContact(instance_name="doc", resources=str(stage))
+        return list(inst._specs)
+    finally:
+        sys.path.remove(str(stage))
+
+
+def main(argv: list[str] | None = None) -> int:
+    import argparse
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("dest", nargs="?", default=str(REPO / "fmus"))
+    ap.add_argument("--params", default=None)
+    ns = ap.parse_args(argv)
+    try:
+        print(json.dumps(build_fmu(ns.dest, ns.params), indent=1))
+    except BuildError as exc:
+        print(f"build-fmu: error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,600 @@
+"""RotorCasingContact: FMI 2.0 co-simulation slave around the rotorub library.
+
+This file is the pythonfmu script of ``fmus/RotorCasingContact.fmu`` (built by
+``rotorub build-fmu``, see fmu_src/build.py and docs/FMU.md). It contains no
+physics: every number it outputs comes from the copy of ``rotorub_model`` carried
+in the FMU's resources folder (imported under a build-specific package name so it
+never collides with another copy of the library, or with another pythonfmu FMU,
+in the same interpreter):
+
+* transient mode: :class:`CentralDifference` (``advance`` substeps inside each
+  communication step, ``get_state``/``set_state`` for rollback) and
+  :func:`outputs_from_q` for the per-blade and global outputs;
+* quasi-static mode: :func:`solve_static` warm-started from the previous step and
+  :func:`stability_of` for the largest real part of the eigenvalues.
+
+pythonfmu turns any Python exception escaping a callback into fmi2Fatal and
+destroys the Python instance. So no callback here lets an exception out: bad
+input is reported by ``do_step`` returning False (fmi2Discard) after logging a
+message (status fmi2Error) that names the cause, and the instance stays usable.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import math
+import sys
+from pathlib import Path
+from xml.etree.ElementTree import Element, SubElement
+
+import numpy as np
+from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real, String
+from pythonfmu.enums import Fmi2Status
+
+MANIFEST = "rotorub_fmu.json"
+MODES = ("transient", "quasi_static")
+FORMULATIONS = ("2D", "3D")
+STATUS_OK, STATUS_DIVERGED, STATUS_ERROR = 0, 1, 2
+STATE_VERSION = 1
+
+# FMI 2.0 unit definitions: name -> SI base-unit exponents
+UNITS = {
+    "rad/s": {"rad": 1, "s": -1},
+    "kg.m": {"kg": 1, "m": 1},
+    "m": {"m": 1},
+    "N/m": {"kg": 1, "s": -2},
+    "rad": {"rad": 1},
+    "s": {"s": 1},
+    "N": {"kg": 1, "m": 1, "s": -2},
+    "N.m": {"kg": 1, "m": 2, "s": -2},
+    "1/s": {"s": -1},
+    "1": {},
+}
+
+# submodules of the bundled library imported eagerly: a later lazy import must not
+# depend on the folder it came from still existing (masters delete extracted FMUs)
+_LIB_MODULES = ("errors", "params", "frames", "ritz", "shaft", "blades", "casing", "model", "contact_law",
+                "contact2d", "contact3d", "contact", "results", "linear", "transient", "static", "stability")
+
+
+def _load_library(resources: Path) -> tuple[dict, object]:
+    """(manifest, namespace of the bundled library's modules)."""
+    manifest = json.loads((resources / MANIFEST).read_text())
+    if str(resources) not in sys.path:
+        sys.path.insert(0, str(resources))
+    pkg = manifest["library"]
+
+    class Lib:
+        pass
+
+    lib = Lib()
+    for name in _LIB_MODULES:
+        setattr(lib, name, importlib.import_module(f"{pkg}.{name}"))
+    return manifest, lib
+
+
+class _memoized:
+    """Within the block, ``obj.<name>(q)`` returns the previous result when q holds the same values
+    (the output methods of ContactModel each re-evaluate the contact law for the same state)."""
+
+    def __init__(self, obj, *names):
+        self.obj, self.names = obj, names
+
+    def __enter__(self):
+        for name in self.names:
+            fn = getattr(self.obj, name)
+            cache = {}
+
+            def memo(q, fn=fn, cache=cache):
+                key = q.tobytes()
+                if key not in cache:
+                    cache.clear()
+                    cache[key] = fn(q)
+                return cache[key]
+
+            setattr(self.obj, name, memo)
+        return self.obj
+
+    def __exit__(self, *exc):
+        for name in self.names:
+            self.obj.__dict__.pop(name, None)
+        return False
+
+
+class RotorCasingContact(Fmi2Slave):
+    author = "rotorub developers"
+    description = (
+        "Blade-tip / casing contact of a turbofan fan module (Parent, Thouverez & Chevillot, EURODYN 2014): "
+        "38-dof bladed rotor and flexible casing in the rotating frame, 2D or 3D contact. Spin speed and "
+        "imbalance in, contact forces and gaps out. Wraps the rotorub_model library carried in resources/."
+    )
+    license = "MIT"
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self._resources = Path(self.resources) if self.resources else Path(__file__).parent
+        self._manifest, self._lib = _load_library(self._resources)
+        self.version = self._manifest.get("library_version", "0")
+        self.copyright = "rotorub developers"
+        ref = self._lib.params.load_parameters(self._resources / self._manifest["parameters"])
+        self._ref = ref
+        self._n_blades = int(self._manifest["n_blades"])
+        c = ref.contact
+        self._specs = []
+        self._declare_variables(ref)
+        n = len(self._specs)
+        self._rv = np.zeros(n)
+        self._iv = np.zeros(n, dtype=np.int64)
+        self._sv = [""] * n
+        self._kind = [s[1] for s in self._specs]
+        self._slot = {s[0]: i for i, s in enumerate(self._specs)}
+        self._is_real = np.array([k == "Real" for k in self._kind])
+        self._is_int = np.array([k == "Integer" for k in self._kind])
+        self._settable = np.array([s[2] in ("input", "parameter") for s in self._specs])
+        starts = {
+            "Omega": 0.0, "imbalance": ref.imbalance.me, "g0": c.g0, "k_r": c.k_r, "mu": c.mu,
+            "theta": math.radians(c.theta_deg), "chord": c.chord, "dt_max": 1e-3,
+            "formulation": "3D", "mode": "transient", "param_file": "",
+        }
+        for name, v in starts.items():
+            i = self._slot[name]
+            if self._kind[i] == "String":
+                self._sv[i] = v
+            else:
+                self._rv[i] = v
+        for i, spec in enumerate(self._specs):
+            self._register(i, spec)
+        nb = self._n_blades
+        self._out_slots = {k: np.array([self._slot[f"blade[{j + 1}].{k}"] for j in range(nb)])
+                           for k in ("F_N", "F_T", "gap_LE", "gap_TE", "gap_tip", "contact_fraction")}
+        self._blade_idx = np.concatenate([self._out_slots[k] for k in
+                                          ("F_N", "F_T", "contact_fraction", "gap_LE", "gap_TE", "gap_tip")])
+        self._global_idx = np.array([self._slot[k] for k in (
+            "casing_force.x", "casing_force.y", "casing_force.z", "friction_torque", "disk_displacement.x",
+            "disk_displacement.y", "gap_min", "max_real_eig")])
+        self._phase = "instantiated"  # -> initialization -> step
+        self._t = 0.0  # current communication point
+        self._sim = None  # runtime objects, built at the end of initialization
+        self._fatal_msg = None  # a configuration error: every step is refused until reset
+        self._warned_fixed = set()
+
+    # ------------------------------------------------------------------ variables
+    def _declare_variables(self, ref) -> None:
+        S = self._specs.append
+        S(("Omega", "Real", "input", "continuous", "rad/s",
+           "Spin speed of the rotor; held constant over each communication step (zero-order hold), >= 0"))
+        S(("imbalance", "Real", "input", "continuous", "kg.m",
+           "Imbalance m*e on the fan disk (angle and disk from the parameter file); held over each step, >= 0"))
+        S(("formulation", "String", "parameter", "fixed", None, "Contact formulation: '2D' (tip point) or '3D' "
+           "(conical casing, LE and TE points, chord law)"))
+        S(("mode", "String", "parameter", "fixed", None, "Analysis mode: 'transient' (central differences, "
+           "substeps inside each communication step) or 'quasi_static' (balanced static solution at the "
+           "current inputs, warm-started from the last one, with its stability indicator)"))
+        S(("param_file", "String", "parameter", "fixed", None, "Optional path to a rotorub TOML parameter file "
+           "(empty: the reference file carried in the FMU); g0, k_r, mu, theta, chord below override its "
+           "[contact] section"))
+        S(("g0", "Real", "parameter", "tunable", "m", "Nominal blade-tip clearance (negative = interference); "
+           "tunable between communication steps"))
+        S(("k_r", "Real", "parameter", "fixed", "N/m", "Normal penalty stiffness of one whole blade tip"))
+        S(("mu", "Real", "parameter", "fixed", "1", "Coulomb friction coefficient"))
+        S(("theta", "Real", "parameter", "fixed", "rad", "Inclination of the conical casing inner surface (3D)"))
+        S(("chord", "Real", "parameter", "fixed", "m", "Blade-tip chord length l_c (3D)"))
+        S(("dt_max", "Real", "parameter", "fixed", "s", "Upper limit of the internal time step (transient mode); "
+           "the step actually used is h/n with n = ceil(h / min(dt_max, half the central-difference "
+           "stability limit)), h the communication step; must be > 0"))
+        for j in range(1, self._n_blades + 1):
+            b = f"blade[{j}]"
+            S((f"{b}.F_N", "Real", "output", "continuous", "N", f"Normal contact force on blade {j}"))
+            S((f"{b}.F_T", "Real", "output", "continuous", "N",
+               f"Tangential (friction) contact force on blade {j}, mu*F_N, opposing the spin"))
+            S((f"{b}.gap_LE", "Real", "output", "continuous", "m",
+               f"Gap at the leading edge of blade {j} (3D; 2D: the tip gap); negative = penetration"))
+            S((f"{b}.gap_TE", "Real", "output", "continuous", "m",
+               f"Gap at the trailing edge of blade {j} (3D; 2D: the tip gap); negative = penetration"))
+            S((f"{b}.gap_tip", "Real", "output", "continuous", "m",
+               f"Tip gap of blade {j} (2D); 3D: the smaller of the LE and TE gaps (the gap is linear "
+               "along the chord)"))
+            S((f"{b}.contact_fraction", "Real", "output", "continuous", "1",
+               f"Fraction of the chord of blade {j} in contact (2D: 0 or 1)"))
+        S(("n_contact", "Integer", "output", "discrete", None, "Number of blades in contact (F_N > 0)"))
+        for ax in "xyz":
+            S((f"casing_force.{ax}", "Real", "output", "continuous", "N",
+               f"Resultant contact force on the casing, fixed frame, {ax} component (z: axial)"))
+        S(("friction_torque", "Real", "output", "continuous", "N.m",
+           "Axial torque of the contact forces on the rotor (negative: brakes the spin)"))
+        for ax in "xy":
+            S((f"disk_displacement.{ax}", "Real", "output", "continuous", "m",
+               f"Fan-disk centre displacement, fixed frame, {ax} component"))
+        S(("gap_min", "Real", "output", "continuous", "m", "Smallest gap over all blades and contact points"))
+        S(("max_real_eig", "Real", "output", "continuous", "1/s",
+           "Largest real part of the eigenvalues linearised about the static solution (quasi_static mode; "
+           "> 0: unstable); 0 in transient mode (not computed)"))
+        S(("status", "Integer", "output", "discrete", None,
+           "0 = ok, 1 = diverged (transient: penetration beyond 10 mm or non-finite state; quasi_static: "
+           "no balanced solution found), 2 = bad input or configuration (message in the log)"))
+        S(("dt_internal", "Real", "output", "discrete", "s",
+           "Internal time step used in the last communication step (transient mode; 0 in quasi_static)"))
+        S(("n_substeps", "Integer", "output", "discrete", None,
+           "Number of internal steps taken in the last communication step (transient mode)"))
+
+    def _register(self, i: int, spec) -> None:
+        name, kind, causality, variability, _unit, desc = spec
+        caus = Fmi2Causality[causality]
+        var = Fmi2Variability[variability]
+        initial = Fmi2Initial.calculated if causality == "output" else None
+        store, conv, cls = {"Real": (self._rv, float, Real), "Integer": (self._iv, int, Integer),
+                            "String": (self._sv, str, String)}[kind]
+
+        def getter(i=i, store=store, conv=conv):
+            return conv(store[i])
+
+        def setter(v, i=i, conv=conv):
+            self._set_value(i, conv(v))
+
+        v = cls(name, causality=caus, variability=var, description=desc, initial=initial, getter=getter,
+                setter=setter)
+        self.register_variable(v, nested=False)
+        assert v.value_reference == i
+
+    def _set_value(self, i: int, value) -> None:
+        """Store a value set by the master; never raises (checks happen in do_step)."""
+        name, kind, causality, variability = self._specs[i][:4]
+        if not self._settable[i]:
+            self.log(f"{name}: is an output and cannot be set; value ignored", Fmi2Status.error)
+            return
+        if self._phase == "step" and variability == "fixed":
+            if name not in self._warned_fixed:
+                self._warned_fixed.add(name)
+                self.log(f"{name}: fixed parameter, cannot change after initialization (reset first); "
+                         "new value ignored", Fmi2Status.warning)
+            return
+        if kind == "Real":
+            self._rv[i] = value
+        elif kind == "Integer":
+            self._iv[i] = value
+        else:
+            self._sv[i] = value
+
+    # fast paths for the per-step traffic (same semantics as pythonfmu's)
+    def get_real(self, vrs):
+        idx = np.asarray(vrs, dtype=np.intp)
+        if not self._is_real[idx].all():
+            raise TypeError(f"get_real: value reference(s) {idx[~self._is_real[idx]].tolist()} are not Real")
+        return self._rv[idx].tolist()
+
+    def get_integer(self, vrs):
+        idx = np.asarray(vrs, dtype=np.intp)
+        if not self._is_int[idx].all():
+            raise TypeError(f"get_integer: value reference(s) {idx[~self._is_int[idx]].tolist()} are not Integer")
+        return self._iv[idx].tolist()
+
+    def set_real(self, vrs, values):
+        for vr, v in zip(vrs, values):
+            if self._kind[vr] != "Real":
+                self.log(f"set_real: value reference {vr} is not Real; ignored", Fmi2Status.error)
+                continue
+            self._set_value(vr, float(v))
+
+    def _r(self, name: str) -> float:
+        return float(self._rv[self._slot[name]])
+
+    def _s(self, name: str) -> str:
+        return self._sv[self._slot[name]]
+
+    # ------------------------------------------------------------------ model description
+    def to_xml(self, model_options=None):
+        """pythonfmu's description plus what it lacks: units, InitialUnknowns, a default experiment."""
+        root = super().to_xml(model_options or {})
+        children = list(root)
+        units = Element("UnitDefinitions")
+        for name, base in UNITS.items():
+            u = SubElement(units, "Unit", name=name)
+            if base:
+                SubElement(u, "BaseUnit", {k: str(v) for k, v in base.items()})
+        cs_pos = next(i for i, el in enumerate(children) if el.tag == "CoSimulation")
+        root.insert(cs_pos + 1, units)
+        if root.find("DefaultExperiment") is None:
+            de = Element("DefaultExperiment", startTime="0", stopTime="1.5", stepSize="0.001")
+            mv_pos = list(root).index(root.find("ModelVariables"))
+            root.insert(mv_pos, de)
+        for sv, spec in zip(root.find("ModelVariables"), self._specs):
+            unit = spec[4]
+            if unit is not None:
+                sv.find("Real").set("unit", unit)
+        ms = root.find("ModelStructure")
+        outs = ms.find("Outputs")
+        if outs is not None:
+            init = SubElement(ms, "InitialUnknowns")
+            for u in outs:
+                SubElement(init, "Unknown", index=u.get("index"))
+        return root
+
+    # ------------------------------------------------------------------ FMI life cycle
+    def setup_experiment(self, start_time=0.0, stop_time=None, tolerance=None):
+        self._t = float(start_time or 0.0)
+
+    def enter_initialization_mode(self, *args):
+        self._phase = "initialization"
+
+    def exit_initialization_mode(self, *args):
+        self._phase = "step"
+        try:
+            self._build()
+        except Exception as exc:  # noqa: BLE001 - reported, never raised (pythonfmu would go fatal)
+            self._configuration_error(self._message(exc))
+
+    def terminate(self):
+        self._phase = "terminated"
+
+    def do_step(self, current_time, step_size):
+        try:
+            return self._do_step(float(current_time), float(step_size))
+        except Exception as exc:  # noqa: BLE001 - last resort: report instead of dying
+            self._report(STATUS_ERROR, f"internal error at t = {current_time:g} s: {self._message(exc)}")
+            return False
+
+    # ------------------------------------------------------------------ messages
+    @staticmethod
+    def _message(exc: Exception) -> str:
+        return f"{type(exc).__name__}: {exc}" if not str(exc).strip() else str(exc)
+
+    def _report(self, status: int, msg: str) -> None:
+        self._iv[self._slot["status"]] = status
+        self.log(f"RotorCasingContact: {msg}", Fmi2Status.error if status == STATUS_ERROR else Fmi2Status.discard)
+
+    def _configuration_error(self, msg: str) -> None:
+        self._fatal_msg = msg
+        self._sim = None
+        self._report(STATUS_ERROR, msg + " (every step is refused until the FMU is reset)")
+
+    # ------------------------------------------------------------------ building the model
+    def _config(self) -> dict:
+        return {k: (self._s(k) if self._kind[self._slot[k]] == "String" else self._r(k))
+                for k in ("formulation", "mode", "param_file", "k_r", "mu", "theta", "chord", "dt_max")}
+
+    def _build(self, config: dict | None = None) -> None:
+        """Check the parameters and build model, contact and solver (raises with a message naming the cause)."""
+        lib = self._lib
+        cfg = config or self._config()
+        self._fatal_msg = None
+        self._sim = None
+        if cfg["mode"] not in MODES:
+            raise ValueError(f"mode: '{cfg['mode']}' unknown; accepted: {', '.join(MODES)}")
+        if cfg["formulation"] not in FORMULATIONS:
+            raise ValueError(f"formulation: '{cfg['formulation']}' unknown; accepted: {', '.join(FORMULATIONS)}")
+        dt_max = cfg["dt_max"]
+        if not (math.isfinite(dt_max) and dt_max > 0):
+            raise ValueError(f"dt_max: {dt_max:g} s out of range; the internal time step limit must be finite "
+                             "and > 0; accepted range (0, inf) s")
+        path = cfg["param_file"].strip()
+        params = lib.params.load_parameters(path) if path else self._ref
+        if params.blades.count != self._n_blades:
+            raise ValueError(f"param_file '{path}': blades.count = {params.blades.count}, but this FMU declares "
+                             f"outputs for {self._n_blades} blades; rebuild it with "
+                             f"`rotorub build-fmu --params {path}`")
+        g0 = self._r("g0")
+        params = params.replace(contact={"g0": g0, "k_r": cfg["k_r"], "mu": cfg["mu"],
+                                         "theta_deg": math.degrees(cfg["theta"]), "chord": cfg["chord"]})
+        model = lib.model.build_model(params)
+        contact = lib.contact.make_contact(model, cfg["formulation"])
+        sim = {"config": cfg, "model": model, "contact": contact, "g0": g0, "phi": 0.0, "q_static": None,
+               "limit": (None, None), "T2": np.ascontiguousarray(model.disk_maps[0][:2])}
+        if cfg["mode"] == "transient":
+            omega0 = self._r("Omega")
+            w = omega0 if math.isfinite(omega0) and omega0 >= 0 else 0.0
+            sim["cd"] = lib.transient.CentralDifference(model, contact, dt=None, t_ramp=0.0, omega_max_for_dt=w)
+            q = sim["cd"].q
+        else:
+            q = np.zeros(model.n_dofs)
+        self._sim = sim
+        self._iv[self._slot["status"]] = STATUS_OK
+        self._write_outputs(q, 0.0, max_real=0.0)
+        if cfg["mode"] == "quasi_static":
+            err = self._check_inputs()
+            if err is None:  # balanced solution at the initial inputs (else reported by the first step)
+                ok, msg = self._quasi_static(self._r("Omega"), self._r("imbalance"), 0.0)
+                if not ok:
+                    self._report(STATUS_DIVERGED, msg)
+
+    # ------------------------------------------------------------------ stepping
+    def _check_inputs(self) -> str | None:
+        om, me, g0 = self._r("Omega"), self._r("imbalance"), self._r("g0")
+        if not math.isfinite(om) or om < 0:
+            return f"Omega: {om!r} rad/s is not a valid spin speed; accepted range [0, inf) rad/s (finite)"
+        if not math.isfinite(me) or me < 0:
+            return f"imbalance: {me!r} kg.m out of range; accepted range [0, inf) kg.m (finite)"
+        lb = self._sim["model"].params.blades.length if self._sim else math.inf
+        if not math.isfinite(g0) or g0 <= -0.5 * lb:
+            return f"g0: {g0!r} m out of range; accepted range (-blades.length/2 = {-0.5 * lb:g}, inf) m"
+        return None
+
+    def _do_step(self, t: float, h: float) -> bool:
+        if self._fatal_msg is not None:
+            self._report(STATUS_ERROR, self._fatal_msg + " (every step is refused until the FMU is reset)")
+            return False
+        if self._sim is None:
+            self._configuration_error("do_step called before the end of initialization "
+                                      "(fmi2ExitInitializationMode)")
+            return False
+        if not (math.isfinite(h) and h > 0):
+            self._report(STATUS_ERROR, f"communication step size {h!r} s: must be finite and > 0")
+            return False
+        err = self._check_inputs()
+        if err is not None:
+            self._report(STATUS_ERROR, f"at t = {t:g} s: {err}; step refused, state unchanged")
+            return False
+        sim = self._sim
+        omega, me, g0 = self._r("Omega"), self._r("imbalance"), self._r("g0")
+        if g0 != sim["g0"]:
+            sim["g0"] = g0
+            sim["contact"] = sim["contact"].with_clearance(g0)
+            if "cd" in sim:
+                sim["cd"].set_clearance(g0)
+        if sim["config"]["mode"] == "transient":
+            ok = self._transient(omega, me, h)
+        else:
+            ok, msg = self._quasi_static(omega, me, h)
+            if not ok:
+                self._report(STATUS_DIVERGED, f"at t = {t:g} s: {msg}")
+        if ok:
+            self._t = t + h
+            self._iv[self._slot["status"]] = STATUS_OK
+        return ok
+
+    def _stability_cap(self, omega: float) -> float:
+        """Half the central-difference stability limit at omega (the library's default step), cached."""
+        sim = self._sim
+        w, lim = sim["limit"]
+        if w != omega:
+            lim = self._lib.transient.critical_time_step(sim["model"], sim["contact"], omega)
+            sim["limit"] = (omega, lim)
+        return 0.5 * lim
+
+    def _transient(self, omega: float, me: float, h: float) -> bool:
+        sim = self._sim
+        cd = sim["cd"]
+        if cd.diverged:
+            self._report(STATUS_DIVERGED, f"the run diverged at t = {cd.t:.6g} s (internal time); roll back "
+                         "with fmi2SetFMUstate or reset the FMU")
+            return False
+        cap = min(sim["config"]["dt_max"], self._stability_cap(omega))
+        # keep the current step if it divides h (within round-off of the master's time arithmetic)
+        n_cur = round(h / cd.dt)
+        if n_cur >= 1 and abs(n_cur * cd.dt - h) <= 1e-9 * h and cd.dt <= cap * (1 + 1e-9):
+            n = n_cur
+        else:
+            n = max(1, math.ceil(h / cap * (1 - 1e-9)))
+            dt_new = h / n
+            if dt_new != cd.dt:  # restart the two-step scheme at the same velocity
+                v = cd.velocity()
+                cd.dt = dt_new
+                cd.q_prev[:] = cd.q - dt_new * v
+        done, _ = cd.advance(n, omega, me)
+        self._rv[self._slot["dt_internal"]] = cd.dt
+        self._iv[self._slot["n_substeps"]] = done
+        if cd.diverged or done < n:
+            pen = cd.max_penetration
+            self._report(STATUS_DIVERGED, f"the run diverged at t = {cd.t:.6g} s (internal time): a gap fell "
+                         f"below -{pen * 1e3:g} mm (blade through the casing liner, penalty contact meaningless) "
+                         "or the state stopped being finite; outputs hold the last good step")
+            return False
+        self._write_outputs(cd.q, cd.phi, max_real=0.0)
+        return True
+
+    def _quasi_static(self, omega: float, me: float, h: float) -> tuple[bool, str]:
+        sim, lib = self._sim, self._lib
+        st = lib.static.solve_static(sim["model"], sim["contact"], omega, me=me, q0=sim["q_static"])
+        if not st.converged:
+            return False, (f"no balanced static solution at Omega = {omega:g} rad/s, imbalance = {me:g} kg.m, "
+                           f"g0 = {sim['g0']:g} m (relative residual {st.residual:.2e}); outputs hold the last "
+                           "solution")
+        stab = lib.stability.stability_of(sim["model"], sim["contact"], omega, st.q)
+        sim["q_static"] = st.q
+        sim["phi"] += omega * h
+        self._rv[self._slot["dt_internal"]] = 0.0
+        self._iv[self._slot["n_substeps"]] = 0
+        self._write_outputs(st.q, sim["phi"], max_real=stab.max_real)
+        return True, ""
+
+    def _write_outputs(self, q: np.ndarray, phi: float, max_real: float) -> None:
+        """The outputs of :func:`outputs_from_q` for one state, composed from the same library calls
+        (ContactModel.blade_forces, resultant_on_casing, friction_torque_on_rotor, Model.disk_maps,
+        rotate_to_fixed) with the contact law evaluated once instead of three times."""
+        sim, lib = self._sim, self._lib
+        contact = sim["contact"]
+        with _memoized(contact, "laws", "point_forces"):
+            bf = contact.blade_forces(q)
+            Fc = contact.resultant_on_casing(q)
+            torque = contact.friction_torque_on_rotor(q)
+        v = np.zeros((2, 3))
+        v[0, :2] = sim["T2"] @ q
+        v[1] = Fc
+        fixed = lib.transient.rotate_to_fixed(v, phi)
+        FN = bf["F_N"]
+        gap = bf["gap"]
+        tip = gap.min(axis=1)
+        self._rv[self._blade_idx] = np.concatenate((FN, bf["F_T"], bf["fraction"], gap[:, 0], gap[:, -1], tip))
+        self._rv[self._global_idx] = (fixed[1, 0], fixed[1, 1], fixed[1, 2], torque, fixed[0, 0], fixed[0, 1],
+                                      tip.min(), max_real)
+        self._iv[self._slot["n_contact"]] = np.count_nonzero(FN > 0)
+
+    # ------------------------------------------------------------------ FMU state (rollback)
+    def _get_fmu_state(self):
+        """Everything a rollback needs: variable values, phase, solver state, warm start, outputs."""
+        sim = self._sim
+        state = {
+            "version": STATE_VERSION,
+            "rv": self._rv.copy(), "iv": self._iv.copy(), "sv": list(self._sv),
+            "phase": self._phase, "t": self._t, "fatal": self._fatal_msg, "sim": None,
+        }
+        if sim is not None:
+            s = {"config": dict(sim["config"]), "g0": sim["g0"], "phi": sim["phi"],
+                 "q_static": None if sim["q_static"] is None else sim["q_static"].copy()}
+            if "cd" in sim:
+                t, steps, phi, q, q_prev, div, dt, g0 = sim["cd"].get_state()
+                s["cd"] = {"t": t, "steps": steps, "phi": phi, "q": q, "q_prev": q_prev, "diverged": div,
+                           "dt": dt, "g0": g0}
+            state["sim"] = s
+        return state
+
+    def _set_fmu_state(self, state):
+        try:
+            self._restore(state)
+        except Exception as exc:  # noqa: BLE001
+            self._configuration_error(f"fmi2SetFMUstate: the state could not be restored ({self._message(exc)})")
+
+    def _restore(self, state) -> None:
+        if not isinstance(state, dict) or state.get("version") != STATE_VERSION:
+            raise ValueError(state.get("error", "not a RotorCasingContact state of this version")
+                             if isinstance(state, dict) else "not a RotorCasingContact state")
+        rv, iv = np.asarray(state["rv"], dtype=float), np.asarray(state["iv"], dtype=np.int64)
+        if rv.shape != self._rv.shape:
+            raise ValueError("the state was saved by an FMU with another variable set")
+        self._rv[:] = rv
+        self._iv[:] = iv
+        self._sv[:] = list(state["sv"])
+        self._phase, self._t, self._fatal_msg = state["phase"], float(state["t"]), state["fatal"]
+        s = state["sim"]
+        if s is None:
+            self._sim = None
+            return
+        if self._sim is None or self._sim["config"] != s["config"]:
+            g0 = self._r("g0")
+            self._rv[self._slot["g0"]] = s["g0"]
+            self._build(dict(s["config"]))
+            self._rv[self._slot["g0"]] = g0
+            self._rv[:] = rv
+            self._iv[:] = iv
+        sim = self._sim
+        if s["g0"] != sim["g0"]:
+            sim["g0"] = s["g0"]
+            sim["contact"] = sim["contact"].with_clearance(s["g0"])
+        sim["phi"] = float(s["phi"])
+        sim["q_static"] = None if s["q_static"] is None else np.array(s["q_static"], dtype=float)
+        if "cd" in s:
+            c = s["cd"]
+            sim["cd"].set_state((c["t"], c["steps"], c["phi"], np.asarray(c["q"], dtype=float),
+                                 np.asarray(c["q_prev"], dtype=float), c["diverged"], c["dt"], c["g0"]))
+
+    @staticmethod
+    def _fmu_state_to_bytes(state) -> bytes:
+        def plain(x):
+            if isinstance(x, np.ndarray):
+                return x.tolist()
+            if isinstance(x, dict):
+                return {k: plain(v) for k, v in x.items()}
+            if isinstance(x, list | tuple):
+                return [plain(v) for v in x]
+            if isinstance(x, np.generic):
+                return x.item()
+            return x
+
+        return json.dumps(plain(state)).encode("utf-8")  # floats round-trip exactly (shortest repr)
+
+    @staticmethod
+    def _fmu_state_from_bytes(data: bytes):
+        try:
+            return json.loads(bytes(data).decode("utf-8"))
+        except Exception as exc:  # noqa: BLE001 - surfaced by _set_fmu_state
+            return {"version": None, "error": f"serialized state is not valid ({exc})"}
