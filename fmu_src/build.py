@@ -33,9 +33,10 @@ import zipfile
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-REPO = HERE.parent
 SCRIPT = HERE / "rotorub_casing_contact.py"
-LIB = REPO / "rotorub_model"
+import rotorub_model  # noqa: E402 - the sources that travel inside the FMU, wherever they are installed
+
+LIB = Path(rotorub_model.__file__).resolve().parent
 MODEL_IDENTIFIER = "RotorCasingContact"
 HOST_REQUIREMENTS = ["numpy>=1.26", "scipy>=1.11", "numba>=0.59"]
 
@@ -122,7 +123,7 @@ or 1 (diverged). The instance stays usable: corrected inputs, fmi2SetFMUstate or
 </table>
 </body></html>
 """)
-    fmu_md = REPO / "docs" / "FMU.md"
+    fmu_md = HERE / "FMU.md"
     if fmu_md.exists():
         shutil.copy2(fmu_md, doc / "FMU.md")
 
@@ -134,12 +135,9 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None) 
         from pythonfmu import __version__ as pythonfmu_version
     except ImportError:
         raise BuildError("pythonfmu is not installed: pip install 'rotorub[fmu]'") from None
-    sys.path.insert(0, str(REPO))
-    try:
-        from rotorub_model import __version__ as lib_version
-        from rotorub_model.params import load_parameters
-    finally:
-        sys.path.remove(str(REPO))
+    from rotorub_model import __version__ as lib_version
+    from rotorub_model.params import load_parameters
+
     params_path = Path(params_file) if params_file else LIB / "data" / "reference.toml"
     params = load_parameters(params_path)  # validated now, not in the master
     dest = Path(dest)
@@ -148,7 +146,7 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None) 
     files = _library_files()
     h = hashlib.sha256()
     for p in [SCRIPT, params_path, *files]:
-        h.update(str(p.relative_to(REPO) if p.is_relative_to(REPO) else p.name).encode())
+        h.update(str(p.relative_to(LIB) if p.is_relative_to(LIB) else p.name).encode())
         h.update(p.read_bytes())
     h.update(pythonfmu_version.encode())
     tag = h.hexdigest()[:10]
@@ -223,7 +221,7 @@ def main(argv: list[str] | None = None) -> int:
     import argparse
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("dest", nargs="?", default=str(REPO / "fmus"))
+    ap.add_argument("dest", nargs="?", default="fmus")
     ap.add_argument("--params", default=None)
     ns = ap.parse_args(argv)
     try:

@@ -199,16 +199,12 @@ def cmd_reproduce(ns: argparse.Namespace) -> dict:
 def cmd_build_fmu(ns: argparse.Namespace) -> dict:
     """--params FILE becomes the FMU's default parameter file; --out is the folder of the .fmu
     (default for this command: fmus/). Needs the repository's fmu_src/ and pythonfmu."""
-    import importlib.util
-
     from .errors import ParameterError
 
-    src = Path(__file__).resolve().parents[1] / "fmu_src" / "build.py"
-    if not src.exists():
-        raise ParameterError(f"build-fmu: {src} not found; run it from a checkout of the repository")
-    spec = importlib.util.spec_from_file_location("_rotorub_fmu_build", src)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    try:
+        from fmu_src import build as mod
+    except ImportError as exc:
+        raise ParameterError(f"build-fmu: {exc}; install the FMU extra: pip install -e '.[fmu]'") from None
     dest = Path("fmus") if ns.out == "out/build-fmu" else Path(ns.out)
     try:
         return mod.build_fmu(dest, ns.params)
