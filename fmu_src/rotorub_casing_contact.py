@@ -74,34 +74,6 @@ def _load_library(resources: Path) -> tuple[dict, object]:
     return manifest, lib
 
 
-class _memoized:
-    """Within the block, ``obj.<name>(q)`` returns the previous result when q holds the same values
-    (the output methods of ContactModel each re-evaluate the contact law for the same state)."""
-
-    def __init__(self, obj, *names):
-        self.obj, self.names = obj, names
-
-    def __enter__(self):
-        for name in self.names:
-            fn = getattr(self.obj, name)
-            cache = {}
-
-            def memo(q, fn=fn, cache=cache):
-                key = q.tobytes()
-                if key not in cache:
-                    cache.clear()
-                    cache[key] = fn(q)
-                return cache[key]
-
-            setattr(self.obj, name, memo)
-        return self.obj
-
-    def __exit__(self, *exc):
-        for name in self.names:
-            self.obj.__dict__.pop(name, None)
-        return False
-
-
 class RotorCasingContact(Fmi2Slave):
     author = "rotorub developers"
     description = (
@@ -212,7 +184,11 @@ class RotorCasingContact(Fmi2Slave):
            "> 0: unstable); 0 in transient mode (not computed)"))
         S(("status", "Integer", "output", "discrete", None,
            "0 = ok, 1 = diverged (transient: penetration beyond 10 mm or non-finite state; quasi_static: "
-           "no balanced solution found), 2 = bad input or configuration (message in the log)"))
+           "no balanced solution found), 2 = bad input or configuration (message in the log and in 'message')"))
+        S(("message", "String", "output", "discrete", None,
+           "Cause of the last refused step (the text also sent to the FMI logger); empty after a step that "
+           "succeeded. pythonfmu forwards log messages only when the master enables logging, this output "
+           "does not depend on it"))
         S(("dt_internal", "Real", "output", "discrete", "s",
            "Internal time step used in the last communication step (transient mode; 0 in quasi_static)"))
         S(("n_substeps", "Integer", "output", "discrete", None,
@@ -341,6 +317,7 @@ class RotorCasingContact(Fmi2Slave):
 
     def _report(self, status: int, msg: str) -> None:
         self._iv[self._slot["status"]] = status
+        self._sv[self._slot["message"]] = msg
         self.log(f"RotorCasingContact: {msg}", Fmi2Status.error if status == STATUS_ERROR else Fmi2Status.discard)
 
     def _configuration_error(self, msg: str) -> None:
@@ -440,6 +417,7 @@ class RotorCasingContact(Fmi2Slave):
         if ok:
             self._t = t + h
             self._iv[self._slot["status"]] = STATUS_OK
+            self._sv[self._slot["message"]] = ""
         return ok
 
     def _stability_cap(self, omega: float) -> float:
@@ -498,25 +476,18 @@ class RotorCasingContact(Fmi2Slave):
         return True, ""
 
     def _write_outputs(self, q: np.ndarray, phi: float, max_real: float) -> None:
-        """The outputs of :func:`outputs_from_q` for one state, composed from the same library calls
-        (ContactModel.blade_forces, resultant_on_casing, friction_torque_on_rotor, Model.disk_maps,
-        rotate_to_fixed) with the contact law evaluated once instead of three times."""
-        sim, lib = self._sim, self._lib
-        contact = sim["contact"]
-        with _memoized(contact, "laws", "point_forces"):
-            bf = contact.blade_forces(q)
-            Fc = contact.resultant_on_casing(q)
-            torque = contact.friction_torque_on_rotor(q)
-        v = np.zeros((2, 3))
-        v[0, :2] = sim["T2"] @ q
-        v[1] = Fc
-        fixed = lib.transient.rotate_to_fixed(v, phi)
-        FN = bf["F_N"]
-        gap = bf["gap"]
+        """The outputs of the library's :func:`outputs_from_q` for one state (ContactModel.outputs,
+        the fan-disk map of Model.disk_maps, the rotation to the fixed frame)."""
+        sim = self._sim
+        o = sim["contact"].outputs(q)
+        c, s = math.cos(phi), math.sin(phi)
+        dx, dy = sim["T2"] @ q
+        Fx, Fy, Fz = o["casing_force"]
+        FN, gap = o["F_N"], o["gap"]
         tip = gap.min(axis=1)
-        self._rv[self._blade_idx] = np.concatenate((FN, bf["F_T"], bf["fraction"], gap[:, 0], gap[:, -1], tip))
-        self._rv[self._global_idx] = (fixed[1, 0], fixed[1, 1], fixed[1, 2], torque, fixed[0, 0], fixed[0, 1],
-                                      tip.min(), max_real)
+        self._rv[self._blade_idx] = np.concatenate((FN, o["F_T"], o["fraction"], gap[:, 0], gap[:, -1], tip))
+        self._rv[self._global_idx] = (c * Fx - s * Fy, s * Fx + c * Fy, Fz, o["friction_torque"],
+                                      c * dx - s * dy, s * dx + c * dy, tip.min(), max_real)
         self._iv[self._slot["n_contact"]] = np.count_nonzero(FN > 0)
 
     # ------------------------------------------------------------------ FMU state (rollback)

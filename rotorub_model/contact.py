@@ -94,6 +94,20 @@ class ContactModel:
             self.C = Tk[:, 0]
             self.D = np.zeros_like(self.A)
         self._out = np.zeros((self.n_blades, 7))
+        # The casing resultant and the rotor torque are linear in (F_N, M_N) of each blade:
+        # precompute those maps once so per-state outputs cost two small products.
+        nc = g.normals + self.mu * g.tangents  # (N, P, 3) force direction per unit weight, on the casing
+        r = g.points
+        arm = -(r[..., 0] * nc[..., 1] - r[..., 1] * nc[..., 0])  # (N, P) torque on the rotor per unit weight
+        if self.n_points == 2:
+            c = max(g.chord, 1e-300)
+            self._res_F = 0.5 * (nc[:, 0] + nc[:, 1])
+            self._res_M = (nc[:, 1] - nc[:, 0]) / c
+            self._tq_F = 0.5 * (arm[:, 0] + arm[:, 1])
+            self._tq_M = (arm[:, 1] - arm[:, 0]) / c
+        else:
+            self._res_F, self._res_M = nc[:, 0], np.zeros_like(nc[:, 0])
+            self._tq_F, self._tq_M = arm[:, 0], np.zeros_like(arm[:, 0])
 
     @property
     def n_dofs(self) -> int:
@@ -139,6 +153,21 @@ class ContactModel:
             "M_T": self.mu * L[:, 1],
             "gap": g,
             "fraction": L[:, 6].copy(),
+        }
+
+    def outputs(self, q: np.ndarray) -> dict[str, np.ndarray | float]:
+        """Everything an output needs at one state, with the contact law evaluated once:
+        per blade F_N, F_T, M_N, gap (N, P), fraction; the casing resultant (rotating frame)
+        and the friction torque on the rotor (same values as :meth:`resultant_on_casing`
+        and :meth:`friction_torque_on_rotor`)."""
+        g = (self.g0 + self.G @ q).reshape(self.n_blades, self.n_points)
+        L = self._out
+        blade_laws(g, self.k_r, max(self.geometry.chord, 1e-300), self.n_points == 2, L)
+        FN, MN = L[:, 0].copy(), L[:, 1].copy()
+        return {
+            "F_N": FN, "F_T": self.mu * FN, "M_N": MN, "gap": g, "fraction": L[:, 6].copy(),
+            "casing_force": FN @ self._res_F + MN @ self._res_M,
+            "friction_torque": float(FN @ self._tq_F + MN @ self._tq_M),
         }
 
     def point_forces(self, q: np.ndarray) -> np.ndarray:

@@ -271,10 +271,10 @@ def outputs_from_q(model: Model, contact: ContactModel, q: np.ndarray, phi: np.n
     Fc = np.zeros((nt, 3))
     torque = np.zeros(nt)
     for i in range(nt):
-        bf = contact.blade_forces(q[i])
-        FN[i], frac[i], gaps[i] = bf["F_N"], bf["fraction"], bf["gap"]
-        Fc[i] = contact.resultant_on_casing(q[i])
-        torque[i] = contact.friction_torque_on_rotor(q[i])
+        o = contact.outputs(q[i])
+        FN[i], frac[i], gaps[i] = o["F_N"], o["fraction"], o["gap"]
+        Fc[i] = o["casing_force"]
+        torque[i] = o["friction_torque"]
     T, _ = model.disk_maps
     cs = model.slices["casing"]
     disk = (T[:2] @ q.T).T

@@ -1,0 +1,204 @@
+"""Driving pythonfmu FMUs from fmpy without losing their error messages.
+
+Two traps of the stack this module exists for:
+
+* fmpy raises ``FMICallException("fmi2DoStep failed with status 2 (discard)")``: the
+  cause is only in the log, and pythonfmu 0.7 forwards log messages to the master
+  only when the instance was created with ``loggingOn = true``. Every instance made
+  here has logging on and a logger that keeps the messages, and every failed call
+  raises :class:`FMUError` carrying them.
+* pythonfmu's fmi2DoStep can only refuse a step with fmi2Discard (an exception in the
+  slave would be fmi2Fatal), and ``fmpy.simulate_fmu`` takes a discarded step as an
+  early end of the simulation: it returns the rows so far and raises nothing.
+  :func:`simulate` raises :class:`FMUError` when the FMU logged a discard or an error.
+* ``fmpy.simulate_fmu`` takes the communication step from ``output_interval``.
+
+Example
+-------
+>>> from fmu_src.fmi_run import Slave                       # doctest: +SKIP
+>>> with Slave("fmus/RotorCasingContact.fmu", g0=0.2e-3) as s:  # doctest: +SKIP
+...     s.set(Omega=176.0, imbalance=0.022)
+...     s.step(0.0, 1e-3)
+...     s.get("blade[1].F_N")
+"""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+
+import numpy as np
+
+
+class FMUError(RuntimeError):
+    """An FMI call failed; ``messages`` holds what the FMU logged (status >= warning)."""
+
+    def __init__(self, what: str, messages: Sequence[str]):
+        self.messages = list(dict.fromkeys(messages))  # the same cause is often logged twice
+        detail = "; ".join(self.messages) if self.messages else "the FMU logged no message"
+        super().__init__(f"{what}: {detail}")
+
+
+class _Log:
+    """Collects the FMU's log messages (fmi2CallbackLogger)."""
+
+    def __init__(self, echo: bool = False):
+        self.records: list[tuple[int, str]] = []
+        self.echo = echo
+
+    def __call__(self, _env, _instance, status, _category, message) -> None:
+        text = message.decode("utf-8", "replace") if isinstance(message, bytes) else str(message)
+        self.records.append((int(status), text))
+        if self.echo:
+            print(text)
+
+    def problems(self, since: int = 0) -> list[str]:
+        return [m for s, m in self.records[since:] if s >= 1]
+
+
+def simulate(fmu: str | Path, **kwargs) -> np.ndarray:
+    """``fmpy.simulate_fmu`` with logging on; a failure raises :class:`FMUError` with the FMU's messages."""
+    from fmpy import simulate_fmu
+
+    log = _Log()
+    kwargs.setdefault("debug_logging", True)
+    try:
+        result = simulate_fmu(str(fmu), logger=log, **kwargs)
+    except Exception as exc:  # noqa: BLE001 - re-raised with the FMU's own words
+        raise FMUError(str(exc), log.problems()) from exc
+    refused = [m for st, m in log.records if st >= 2]  # fmi2Discard, fmi2Error, fmi2Fatal
+    if refused:
+        t = float(result["time"][-1]) if len(result) else float("nan")
+        raise FMUError(f"simulation stopped at t = {t:g} s", refused)
+    return result
+
+
+class Slave:
+    """One co-simulation instance through fmpy's FMU2Slave, addressed by variable name.
+
+    ``start`` values are set before initialization (parameters, initial inputs).
+    ``unzip_dir``: an already extracted FMU (several instances can share it).
+    """
+
+    def __init__(self, fmu: str | Path, instance_name: str = "instance", unzip_dir: str | Path | None = None,
+                 start_time: float = 0.0, echo_log: bool = False, **start):
+        from fmpy import extract, read_model_description
+        from fmpy.fmi2 import (
+            FMU2Slave,
+            calloc,
+            fmi2CallbackAllocateMemoryTYPE,
+            fmi2CallbackFreeMemoryTYPE,
+            fmi2CallbackFunctions,
+            fmi2CallbackLoggerTYPE,
+            free,
+        )
+
+        self._own_dir = unzip_dir is None
+        self.unzip_dir = str(extract(str(fmu)) if unzip_dir is None else unzip_dir)
+        md = read_model_description(self.unzip_dir)
+        self.model_description = md
+        self.variables = {v.name: v for v in md.modelVariables}
+        self.log = _Log(echo_log)
+        cb = fmi2CallbackFunctions()
+        cb.logger = fmi2CallbackLoggerTYPE(self.log)
+        cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        self._callbacks = cb  # kept alive as long as the instance
+        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=self.unzip_dir,
+                             modelIdentifier=md.coSimulation.modelIdentifier, instanceName=instance_name)
+        self._alive = False
+        self._call("fmi2Instantiate", self.fmu.instantiate, callbacks=cb, loggingOn=True)
+        self._alive = True
+        try:
+            self._call("fmi2SetupExperiment", self.fmu.setupExperiment, startTime=start_time)
+            self._call("fmi2EnterInitializationMode", self.fmu.enterInitializationMode)
+            self.set(**start)
+            self._call("fmi2ExitInitializationMode", self.fmu.exitInitializationMode)
+        except BaseException:
+            self.close()
+            raise
+        self.time = start_time
+
+    # -- plumbing
+    def _call(self, what: str, fn, *args, **kwargs):
+        n0 = len(self.log.records)
+        try:
+            return fn(*args, **kwargs)
+        except Exception as exc:  # noqa: BLE001 - fmpy's FMICallException and friends
+            raise FMUError(f"{what} failed ({exc})", self.log.problems(n0)) from exc
+
+    def _vr(self, name: str):
+        try:
+            return self.variables[name]
+        except KeyError:
+            raise KeyError(f"{name}: no such variable in {self.model_description.modelName}") from None
+
+    # -- values
+    def set(self, **values) -> None:
+        """Set variables by name (Real, Integer, Boolean, String by their declared type)."""
+        for name, value in values.items():
+            v = self._vr(name)
+            fn = {"Real": self.fmu.setReal, "Integer": self.fmu.setInteger, "Boolean": self.fmu.setBoolean,
+                  "String": self.fmu.setString}[v.type]
+            self._call(f"set {name}", fn, [v.valueReference], [value])
+
+    def get(self, name: str):
+        v = self._vr(name)
+        fn = {"Real": self.fmu.getReal, "Integer": self.fmu.getInteger, "Boolean": self.fmu.getBoolean,
+              "String": self.fmu.getString}[v.type]
+        out = self._call(f"get {name}", fn, [v.valueReference])[0]
+        return out.decode() if isinstance(out, bytes) else out
+
+    def get_reals(self, names: Iterable[str]) -> np.ndarray:
+        vrs = [self._vr(n).valueReference for n in names]
+        return np.array(self._call("fmi2GetReal", self.fmu.getReal, vrs))
+
+    def step(self, t: float | None, h: float) -> None:
+        """fmi2DoStep(t, h); raises :class:`FMUError` with the FMU's messages if refused."""
+        t = self.time if t is None else t
+        self._call(f"fmi2DoStep(t = {t:g} s, h = {h:g} s)", self.fmu.doStep, currentCommunicationPoint=t,
+                   communicationStepSize=h)
+        self.time = t + h
+
+    # -- rollback
+    def get_state(self):
+        return self._call("fmi2GetFMUstate", self.fmu.getFMUState), self.time
+
+    def set_state(self, state) -> None:
+        s, t = state
+        self._call("fmi2SetFMUstate", self.fmu.setFMUState, s)
+        self.time = t
+
+    def free_state(self, state) -> None:
+        self._call("fmi2FreeFMUstate", self.fmu.freeFMUState, state[0])
+
+    def serialize(self, state) -> bytes:
+        return bytes(self._call("fmi2SerializeFMUstate", self.fmu.serializeFMUState, state[0]))
+
+    def deserialize(self, data: bytes):
+        return self._call("fmi2DeSerializeFMUstate", self.fmu.deserializeFMUState, data), self.time
+
+    def reset(self) -> None:
+        self._call("fmi2Reset", self.fmu.reset)
+
+    # -- life cycle
+    def close(self) -> None:
+        if self._alive:
+            self._alive = False
+            try:
+                self.fmu.terminate()
+            except Exception:  # noqa: BLE001 - an instance that failed may refuse to terminate; free it anyway
+                pass
+            self.fmu.freeInstance()
+        if self._own_dir:
+            shutil.rmtree(self.unzip_dir, ignore_errors=True)
+
+    def __enter__(self) -> Slave:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+__all__ = ["FMUError", "Slave", "simulate"]

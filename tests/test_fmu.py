@@ -1,0 +1,250 @@
+"""The FMU RotorCasingContact against the library it wraps (issue 5).
+
+Every comparison runs the same arithmetic on both sides (the FMU carries a copy of
+the library), so the tolerances are round-off, not modelling tolerances.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+fmpy = pytest.importorskip("fmpy", reason="the FMU tests drive the FMU with fmpy (pip install -e '.[fmu]')")
+pytest.importorskip("pythonfmu", reason="building the FMU needs pythonfmu (pip install -e '.[fmu]')")
+
+from fmu_src.build import build_fmu  # noqa: E402
+from fmu_src.fmi_run import FMUError, Slave, simulate  # noqa: E402
+from rotorub_model.contact import make_contact  # noqa: E402
+from rotorub_model.stability import stability_of  # noqa: E402
+from rotorub_model.static import solve_static  # noqa: E402
+from rotorub_model.transient import run_transient  # noqa: E402
+
+NB = 10
+FN = [f"blade[{j}].F_N" for j in range(1, NB + 1)]
+LE = [f"blade[{j}].gap_LE" for j in range(1, NB + 1)]
+FR = [f"blade[{j}].contact_fraction" for j in range(1, NB + 1)]
+
+
+@pytest.fixture(scope="module")
+def fmu(tmp_path_factory):
+    out = tmp_path_factory.mktemp("fmus")
+    info = build_fmu(out)
+    return info["fmu"]
+
+
+@pytest.fixture(scope="module")
+def unzipped(fmu, tmp_path_factory):
+    from fmpy import extract
+
+    return extract(fmu, str(tmp_path_factory.mktemp("unzipped")))
+
+
+def test_fmpy_validate_reports_no_problem(fmu):
+    from fmpy.validation import validate_fmu
+
+    assert validate_fmu(fmu) == []
+
+
+def test_model_description_declares_units_and_structured_names(unzipped):
+    from fmpy import read_model_description
+
+    md = read_model_description(unzipped)
+    v = {x.name: x for x in md.modelVariables}
+    assert v["Omega"].causality == "input" and v["Omega"].unit == "rad/s"
+    assert v["imbalance"].unit == "kg.m"
+    assert v["blade[3].F_N"].causality == "output" and v["blade[3].F_N"].unit == "N"
+    assert v["g0"].variability == "tunable"
+    assert all(x.description for x in md.modelVariables)
+    assert {u.name for u in md.unitDefinitions} >= {"rad/s", "N", "m", "N.m", "kg.m"}
+    outs = [x for x in md.modelVariables if x.causality == "output"]
+    assert len(md.initialUnknowns) == len(outs)
+
+
+def test_transient_through_fmpy_equals_library_to_1e_9(fmu, ref_model):
+    """3D, imbalance ramped over 1 s by the master, constant speed, h = 1 ms."""
+    p = ref_model.params
+    omega, g0, me, t_end = 3.3 * p.normalisation.omega_ref, 0.2e-3, p.imbalance.me, 1.5
+    sig = np.array([(0.0, omega, 0.0), (1.0, omega, me), (t_end + 1.0, omega, me)],
+                   dtype=[("time", float), ("Omega", float), ("imbalance", float)])
+    outs = FN + LE + ["friction_torque", "casing_force.x", "casing_force.y", "status", "n_contact"]
+    r = simulate(fmu, stop_time=t_end, output_interval=1e-3, input=sig, start_values={"g0": g0, "formulation": "3D"},
+                 output=outs)
+    lib = run_transient(ref_model, make_contact(ref_model, "3D", g0=g0), omega, t_end=t_end, t_ramp=1.0, me=me,
+                        record_dt=1e-3, hold=1e-3)
+    assert not lib.diverged and np.all(r["status"] == 0)
+    F_fmu = np.array([r[n] for n in FN]).T[1:]  # row 0 is the initial state
+    F_lib = lib.outputs["F_N"]
+    assert F_fmu.shape == F_lib.shape == (1500, NB)
+    scale = np.abs(F_lib).max()
+    assert scale > 50.0, "the scenario must actually rub"
+    assert r["n_contact"].max() >= 2
+    assert np.abs(F_fmu - F_lib).max() <= 1e-9 * scale
+    gap = np.array([r[n] for n in LE]).T[1:]
+    assert np.abs(gap - lib.outputs["gap"][:, :, 0]).max() <= 1e-9 * np.abs(lib.outputs["gap"]).max()
+    tq = lib.outputs["friction_torque"]
+    assert np.abs(r["friction_torque"][1:] - tq).max() <= 1e-9 * np.abs(tq).max()
+    Fc = lib.outputs["casing_force_fixed"]
+    assert np.abs(r["casing_force.x"][1:] - Fc[:, 0]).max() <= 1e-9 * np.abs(Fc).max()
+
+
+def test_quasi_static_mode_equals_static_solver(fmu, ref_model):
+    """A speed sweep through contact: each step the balanced solution, warm-started from the last."""
+    p = ref_model.params
+    w_ref, g0, me = p.normalisation.omega_ref, 0.5e-3, p.imbalance.me
+    speeds = np.linspace(2.9, 3.7, 17) * w_ref
+    h = 0.1
+    with Slave(fmu, mode="quasi_static", formulation="2D", g0=g0, Omega=speeds[0], imbalance=me) as s:
+        got = []
+        for k, w in enumerate(speeds):
+            s.set(Omega=float(w))
+            s.step(k * h, h)
+            got.append((s.get_reals(FN), s.get("max_real_eig"), s.get("n_contact")))
+    c = make_contact(ref_model, "2D", g0=g0)
+    q = solve_static(ref_model, c, speeds[0], me=me).q  # what the FMU solved at initialization
+    n_unstable = 0
+    for (F, re, n), w in zip(got, speeds):
+        st = solve_static(ref_model, c, float(w), me=me, q0=q)
+        assert st.converged
+        q = st.q
+        sb = stability_of(ref_model, c, float(w), q)
+        F_ref = c.outputs(q)["F_N"]
+        assert np.abs(F - F_ref).max() <= 1e-9 * max(np.abs(F_ref).max(), 1.0)
+        assert re == pytest.approx(sb.max_real, rel=1e-9, abs=1e-12)
+        assert n == st.n_contact
+        n_unstable += sb.max_real > 0
+    assert max(g[2] for g in got) >= 2, "the sweep must cross contact"
+    assert n_unstable > 0, "2D contact solutions at these speeds are unstable (paper fact 5)"
+
+
+def _run(s: Slave, n: int, h: float = 1e-3) -> np.ndarray:
+    rows = []
+    for _ in range(n):
+        s.step(None, h)
+        rows.append(s.get_reals(FN + LE))
+    return np.array(rows)
+
+
+def test_rollback_reproduces_the_run_exactly(fmu, unzipped, ref_model):
+    omega = 3.3 * ref_model.params.normalisation.omega_ref
+    with Slave(fmu, unzip_dir=unzipped, g0=0.2e-3, Omega=omega, imbalance=ref_model.params.imbalance.me) as s:
+        _run(s, 150)
+        state = s.get_state()
+        blob = s.serialize(state)
+        first = _run(s, 100)
+        assert first[:, :NB].max() > 10.0  # in contact: the state matters
+        s.set(g0=1.0)  # a tunable change after the snapshot is rolled back too
+        _run(s, 10)
+        s.set_state(state)
+        assert s.get("g0") == 0.2e-3
+        again = _run(s, 100)
+        s.set_state(s.deserialize(blob))
+        from_bytes = _run(s, 100)
+        s.free_state(state)
+    assert np.array_equal(first, again)
+    assert np.array_equal(first, from_bytes)
+
+
+def test_substeps_follow_the_communication_step(fmu, unzipped, ref_model):
+    """Variable step sizes: h = 1 ms and two steps of 0.5 ms use the same internal step, so the
+    states agree exactly at the common points; a step that is not a multiple restarts cleanly."""
+    omega = 3.3 * ref_model.params.normalisation.omega_ref
+    kw = dict(unzip_dir=unzipped, g0=0.2e-3, Omega=omega, imbalance=ref_model.params.imbalance.me)
+    with Slave(fmu, **kw) as a, Slave(fmu, instance_name="b", **kw) as b:
+        ra = _run(a, 200, 1e-3)
+        rb = _run(b, 400, 0.5e-3)[1::2]
+        assert a.get("dt_internal") == b.get("dt_internal") == 0.5e-3
+        assert np.array_equal(ra, rb)
+        b.step(None, 0.37e-3)
+        assert b.get("n_substeps") == 1 and b.get("dt_internal") == pytest.approx(0.37e-3)
+        b.step(None, 2.1e-3)
+        assert b.get("n_substeps") == 5 and b.get("dt_internal") == pytest.approx(0.42e-3)
+        assert b.get("status") == 0
+
+
+def test_g0_is_tunable_between_steps(fmu, unzipped, ref_model):
+    omega = 3.3 * ref_model.params.normalisation.omega_ref
+    with Slave(fmu, unzip_dir=unzipped, g0=0.2e-3, Omega=omega, imbalance=ref_model.params.imbalance.me) as s:
+        F = _run(s, 300)[:, :NB]
+        assert F[-1].max() > 10.0
+        s.set(g0=0.05)
+        s.step(None, 1e-3)
+        assert s.get_reals(FN).max() == 0.0
+        assert s.get("gap_min") > 0.04
+
+
+def test_reset_returns_to_a_fresh_instance(fmu, unzipped, ref_model):
+    omega = 3.3 * ref_model.params.normalisation.omega_ref
+    me = ref_model.params.imbalance.me
+    with Slave(fmu, unzip_dir=unzipped, g0=0.2e-3, Omega=omega, imbalance=me) as s:
+        first = _run(s, 50)
+        s.reset()
+        s.fmu.setupExperiment(startTime=0.0)
+        s.fmu.enterInitializationMode()
+        s.set(g0=0.2e-3, Omega=omega, imbalance=me)
+        s.fmu.exitInitializationMode()
+        s.time = 0.0
+        assert np.array_equal(_run(s, 50), first)
+
+
+BAD_START = [
+    ({"mode": "steady"}, "mode"),
+    ({"formulation": "4D"}, "formulation"),
+    ({"dt_max": 0.0}, "dt_max"),
+    ({"dt_max": -1e-3}, "dt_max"),
+    ({"param_file": "/nonexistent/params.toml"}, "params.toml"),
+]
+
+
+@pytest.mark.parametrize("start,word", BAD_START)
+def test_bad_parameter_is_an_error_naming_it_and_the_next_instance_works(fmu, unzipped, start, word):
+    with pytest.raises(FMUError) as err:
+        simulate(fmu, stop_time=0.003, output_interval=1e-3, start_values=start)
+    assert word in str(err.value)
+    with Slave(fmu, unzip_dir=unzipped, Omega=100.0) as s:  # same process, new instance
+        s.step(0.0, 1e-3)
+        assert s.get("status") == 0
+
+
+@pytest.mark.parametrize("omega", [float("nan"), -1.0, float("inf")])
+def test_bad_spin_speed_refuses_the_step_and_keeps_the_instance(fmu, unzipped, omega):
+    with Slave(fmu, unzip_dir=unzipped, g0=0.2e-3, Omega=150.0, imbalance=0.02) as s:
+        before = _run(s, 5)[-1]
+        s.set(Omega=omega)
+        with pytest.raises(FMUError) as err:
+            s.step(None, 1e-3)
+        assert "Omega" in str(err.value) and "accepted range" in str(err.value)
+        assert s.get("status") == 2 and "Omega" in s.get("message")
+        assert np.array_equal(s.get_reals(FN + LE), before)  # state unchanged
+        s.set(Omega=150.0)
+        s.step(None, 1e-3)  # the same instance goes on
+        assert s.get("status") == 0 and s.get("message") == ""
+
+
+def test_bad_parameter_file_content_names_the_field(fmu, unzipped, tmp_path):
+    from importlib import resources
+
+    bad = tmp_path / "bad.toml"
+    text = resources.files("rotorub_model").joinpath("data/reference.toml").read_text()
+    bad.write_text(text.replace("count = 10 ", "count = 1  "))
+    with pytest.raises(FMUError) as err:
+        simulate(fmu, stop_time=0.002, output_interval=1e-3, start_values={"param_file": str(bad)})
+    assert "blades.count" in str(err.value)
+
+
+def test_divergence_is_reported_and_rollback_recovers(fmu, unzipped):
+    """A clearance of -20 mm pushes every blade through the liner: the run is declared diverged."""
+    with Slave(fmu, unzip_dir=unzipped, g0=0.2e-3, Omega=150.0, imbalance=0.0) as s:
+        _run(s, 3)
+        good = s.get_state()
+        s.set(g0=-0.02)
+        with pytest.raises(FMUError) as err:
+            s.step(None, 1e-3)
+        assert "diverged" in str(err.value)
+        assert s.get("status") == 1
+        with pytest.raises(FMUError):  # stays refused ...
+            s.step(None, 1e-3)
+        s.set_state(good)  # ... until rolled back
+        s.step(None, 1e-3)
+        assert s.get("status") == 0 and math.isfinite(s.get("gap_min"))
