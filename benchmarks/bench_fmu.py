@@ -12,15 +12,15 @@ Printed, all in this one process (numba compiled and the FMU loaded before timin
   outputs) at communication steps h = 1 ms and 0.1 ms;
 * FMU, fmpy FMU2Slave loop: a lean master through fmpy's FMU2Slave (set imbalance,
   fmi2DoStep, get every output each step, preallocated ctypes arrays);
-* library, run_transient: the library's own run with the same internal step and
-  a record (all outputs) every h; its imbalance ramp is smooth, the cost is the same;
+* library, run_transient(hold=h): the library's own run of the same scenario (inputs
+  held over each h as the master does, same internal step, all outputs every h);
 * library, step loop: CentralDifference.advance per h plus outputs_from_q, the
   arithmetic the FMU performs (what the 1e-9 test compares).
 
-The ratio the target is about: FMU (lean fmpy loop) / library run_transient at 1 ms
-(target <= 1.5). Then the resident memory (VmRSS) before and after --steps FMU steps
-(h = 0.1 ms, one internal step each), sampled along the way (target: no growth
-beyond noise).
+The ratios the target is about: FMU (lean fmpy loop) / library run_transient at 1 ms
+(target <= 1.5), and FMU / library step loop (the same per-step traffic without FMI).
+Then the resident memory (VmRSS) before and after --steps FMU steps (h = 0.1 ms,
+one internal step each), sampled along the way (target: no growth beyond noise).
 """
 
 from __future__ import annotations
@@ -81,9 +81,10 @@ def main(argv: list[str] | None = None) -> int:
 
     def fmu_simulate(h):
         t = np.arange(int(round(t_end / h)) + 1) * h
-        sig = np.array(list(zip(t, ramp(t))), dtype=[("time", float), ("imbalance", float)])
+        sig = np.array(list(zip(t, np.full_like(t, omega), ramp(t))),
+                       dtype=[("time", float), ("Omega", float), ("imbalance", float)])
         return simulate_fmu(unzip, model_description=md, stop_time=t_end, output_interval=h,
-                            start_values={"Omega": omega, "g0": g0}, input=sig)
+                            start_values={"g0": g0}, input=sig)
 
     def new_instance(name):
         f = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier=md.coSimulation.modelIdentifier,
@@ -118,8 +119,7 @@ def main(argv: list[str] | None = None) -> int:
         return dt, out
 
     def lib_run_transient(h):
-        return run_transient(model, contact, omega, t_end=t_end, t_ramp=1.0, me=me_max, dt=min(h, 5e-4),
-                             record_dt=h)
+        return run_transient(model, contact, omega, t_end=t_end, t_ramp=1.0, me=me_max, record_dt=h, hold=h)
 
     def lib_step_loop(h):
         n = int(round(t_end / h))
@@ -148,21 +148,22 @@ def main(argv: list[str] | None = None) -> int:
           f"over 1 s, {t_end:g} s simulated; best of {ns.repeat}")
     print(f"{'h [ms]':>7} {'fmpy.simulate_fmu':>18} {'fmpy FMU2Slave loop':>20} {'lib run_transient':>18} "
           f"{'lib step loop':>14} {'loop/run_transient':>19} {'simulate/run_transient':>23}")
-    ratios = {}
+    ratios, steploop = {}, {}
     for h in (1e-3, 1e-4):
         t_sim = best(fmu_simulate, h)
         t_loop = min(fmu_loop(h)[0] for _ in range(ns.repeat))
         t_rt = best(lib_run_transient, h)
         t_sl = best(lib_step_loop, h)
         ratios[h] = t_loop / t_rt
+        steploop[h] = t_loop / t_sl
         print(f"{h * 1e3:7.1f} {t_sim:17.3f}s {t_loop:19.3f}s {t_rt:17.3f}s {t_sl:13.3f}s {t_loop / t_rt:19.2f} "
               f"{t_sim / t_rt:23.2f}")
     n_steps = int(round(t_end / 1e-3))
     print(f"per communication step at 1 ms ({n_steps} steps): FMU lean loop "
           f"{best(lambda: fmu_loop(1e-3)) / n_steps * 1e6:.0f} us, library run_transient "
           f"{best(lib_run_transient, 1e-3) / n_steps * 1e6:.0f} us per record")
-    print(f"target: FMU path <= 1.5 x direct at 1 ms: {'met' if ratios[1e-3] <= 1.5 else 'NOT met'} "
-          f"({ratios[1e-3]:.2f} x)")
+    print(f"target: FMU path <= 1.5 x direct run_transient at 1 ms: {'met' if ratios[1e-3] <= 1.5 else 'NOT met'} "
+          f"({ratios[1e-3]:.2f} x); against the library step loop: {steploop[1e-3]:.2f} x")
 
     # memory over many steps
     if ns.steps > 0:

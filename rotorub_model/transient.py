@@ -200,7 +200,8 @@ class CentralDifference:
             C = m.D + m.G(omega)
             K = m.K_omega(omega) + omega_dot * m.E1
             Aeff = m.M / dt**2 + C / (2 * dt)
-            self._mats = (np.linalg.inv(Aeff), 2 * m.M / dt**2 - K, m.M / dt**2 - C / (2 * dt))
+            self._mats = (np.linalg.inv(Aeff), 2 * m.M / dt**2 - K, m.M / dt**2 - C / (2 * dt),
+                          np.ascontiguousarray(m.force(omega, 1.0, omega_dot)))
             self._key = key
         return self._mats
 
@@ -219,8 +220,7 @@ class CentralDifference:
         """Advance n_steps at constant inputs; returns (steps done, records written)."""
         if self.diverged:
             return 0, rec_start
-        Ainv, K2, Cm1 = self._matrices(omega, omega_dot)
-        f = np.ascontiguousarray(self.model.force(omega, 1.0, omega_dot))
+        Ainv, K2, Cm1, f = self._matrices(omega, omega_dot)
         if rec_q is None:
             rec_q = np.empty((0, self.model.n_dofs))
             rec_every = max(n_steps, 1)
