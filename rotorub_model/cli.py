@@ -188,11 +188,30 @@ def cmd_detect(ns: argparse.Namespace) -> dict:
 
 @command("reproduce", "main job: every analysis of the paper on one configuration, with a summary")
 @arg("--quick", action="store_true", help="coarse grids: a few minutes on 2 cores")
+@arg("--no-fmu", action="store_true", help="library analyses only (no FMU build, harnesses or coupled run)")
+@arg("--fmu-dir", default="fmus", help="where the FMUs are built (default: fmus)")
 def cmd_reproduce(ns: argparse.Namespace) -> dict:
     from .reproduce import run_reproduce
 
-    s = run_reproduce(_model(ns), ns.out, quick=ns.quick)
-    return {"paper_facts": s["paper_facts"], "written": str(Path(ns.out) / "summary.json")}
+    model = _model(ns)
+    s = run_reproduce(model, ns.out, quick=ns.quick)
+    if not ns.no_fmu:
+        from .errors import ParameterError
+
+        try:
+            from fmu_src.reproduce_fmu import run_fmu_part
+        except ImportError as exc:
+            raise ParameterError(f"reproduce: the FMU part needs the fmu extra ({exc}); "
+                                 "pip install -e '.[fmu]', or run with --no-fmu") from None
+        s.update(run_fmu_part(model, ns.out, s, quick=ns.quick, fmu_dir=ns.fmu_dir, params_file=ns.params))
+        from .report import write_report
+        from .results import write_json
+
+        write_json(Path(ns.out) / "summary.json", s)
+        write_report(ns.out, s)
+    keys = ("fmu_vs_library_max_rel_diff", "coupled_run")
+    return {"paper_facts": s["paper_facts"], **{k: s[k] for k in keys if k in s},
+            "written": str(Path(ns.out) / "summary.json")}
 
 
 @command("build-fmu", "package the contact model as fmus/RotorCasingContact.fmu (FMI 2.0 co-simulation)")

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
@@ -26,6 +25,35 @@ def _fmt(v: Any) -> str:
     if isinstance(v, list):
         return "[" + ", ".join(_fmt(x) for x in v) + "]"
     return str(v)
+
+
+def _fmu_section(summary: dict) -> list[str]:
+    h = summary["harnesses"]
+    tr, ru, qs = h["transient"], h["run_up"], h["quasi_static"]
+    rows = [
+        ("transient 2D (section 6), F_N", tr["2D"]["max_rel_diff_F_N_vs_library"],
+         f"diverged: {tr['2D']['diverged']}, blades at 1 s: {tr['2D']['blades_in_contact_at_1s']}"),
+        ("transient 3D (section 6), F_N", tr["3D"]["max_rel_diff_F_N_vs_library"],
+         f"diverged: {tr['3D']['diverged']}, blades at 1 s: {tr['3D']['blades_in_contact_at_1s']}"),
+        ("run-up through the first critical, F_N", ru["max_rel_diff_F_N_vs_library"],
+         f"peak response at Ω = {_fmt(ru['speed_of_peak_response'])}, max F_N {_fmt(ru['max_normal_force_N'])} N"),
+    ]
+    for f, v in qs["vs_library"].items():
+        rows.append((f"quasi-static map {f}, largest real part", v["max_real_max_rel_diff"],
+                     f"{v['cells_same_blades_in_contact']}/{v['cells']} cells same contact state, "
+                     f"{v['cells_other_branch']} on another branch, {v['cells_solved_by_one_only']} solved by one "
+                     f"side only; same stability verdict in {v['same_stability_verdict_fraction']:.0%}"))
+    lines = ["", "## FMU against the library", "",
+             f"Largest relative difference: **{summary['fmu_vs_library_max_rel_diff']:.2e}** "
+             f"({summary.get('fmu_vs_library_note', '')}).", "",
+             "| harness (through the FMU, fmpy) | max rel. diff vs library | notes |", "|---|---|---|"]
+    lines += [f"| {a} | {b:.2e} | {c} |" for a, b, c in rows]
+    c = summary.get("coupled_run")
+    if c:
+        lines += ["", "## Coupled engine scenario (LP spool FMU + contact FMU)", "",
+                  "| quantity | value |", "|---|---|"]
+        lines += [f"| {k} | {_fmt(v)} |" for k, v in c.items() if not isinstance(v, dict | list)]
+    return lines
 
 
 def write_report(out: str | Path, summary: dict) -> Path:
@@ -54,11 +82,10 @@ def write_report(out: str | Path, summary: dict) -> Path:
         lines.append("Every fact holds on this configuration.")
     for f in failing:
         lines.append(f"* Fact {f['id']}: {f.get('why', 'see the values in the table and docs/THEORY.md')}")
-    extra = summary.get("fmu")
-    if extra:
-        lines += ["", "## FMU against the library", "", "```", json.dumps(extra, indent=1), "```"]
+    if "harnesses" in summary:
+        lines += _fmu_section(summary)
     lines += ["", "## Figures", ""]
-    for title, rel in FIGURES:
+    for title, rel in [*FIGURES, *[tuple(x) for x in summary.get("figures_extra", [])]]:
         if (out / rel).exists():
             lines += [f"### {title}", "", f"![{title}]({rel})", ""]
     path = out / "report.md"

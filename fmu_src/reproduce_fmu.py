@@ -1,0 +1,86 @@
+"""The FMU half of ``rotorub reproduce``: build the FMUs, run the harnesses and the coupled
+engine scenario, and add their results to the library's summary and report.
+
+Called by :func:`rotorub_model.cli.cmd_reproduce` after the library analyses (whose
+summary gives the transient point and the stability grid to compare with).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+
+def _step(msg: str) -> None:
+    print(f"[reproduce] {msg}", flush=True)
+
+
+def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: str | Path = "fmus",
+                 params_file: str | Path | None = None, progress: bool = True) -> dict:
+    """Returns the additions to the summary: harness results, fmu_vs_library_max_rel_diff, coupled_run."""
+    from .build import build_fmu
+    from .harness import quasi_static_maps, run_up, transient_pair
+
+    out = Path(out)
+    _step(f"building the FMU into {fmu_dir}/")
+    info = build_fmu(fmu_dir, params_file)
+    fmu = info["fmu"]
+    res: dict = {"fmu": {"file": fmu, "build": info["build"], "variables": info["variables"]}}
+
+    # sections 4-5 through the FMU: a coarser grid than the library's own maps in --quick
+    w = summary["response"]["critical_speeds"][0]
+    gmax = 1.6 * summary["response"]["peak_amplitudes_m"][0]
+    n_sp, n_g = (16, 12) if quick else (60, 40)
+    speeds = np.linspace(max(w - 0.8, 0.05), w + 0.8, n_sp)
+    g0s = gmax * np.linspace(0.0, 1.0, n_g) ** 2
+    _step(f"quasi-static sweeps through the FMU ({n_sp} speeds x {n_g} clearances x 2D/3D) vs the library maps")
+    qs = quasi_static_maps(fmu, model, speeds, g0s, out / "fmu_quasi_static", progress=progress)
+    qs.plot(out / "fmu_quasi_static" / "fmu_maps.png")
+    qsum = qs.summary()
+    (out / "fmu_quasi_static" / "summary.json").write_text(_json(qsum))
+
+    tr = summary["transient"]
+    speed, g0 = float(tr["speed"]), float(tr["g0_mm"]) * 1e-3
+    t_end = float(tr.get("t_end_s", 20.0))
+    _step(f"section 6 transients through the FMU at speed {speed:.3g}, g0 = {g0 * 1e3:.3g} mm, {t_end:g} s")
+    pair = transient_pair(fmu, model, speed, g0, out / "fmu_transient", t_end=t_end, progress=progress)
+    agree = {f: pair[f]["diverged"] == bool(tr.get(f"diverged_{f.lower()}", pair[f]["diverged"]))
+             for f in ("2D", "3D")}
+    pair["same_verdict_as_library_study"] = agree
+
+    _step("run-up through the first critical speed through the FMU (Omega(t) as input)")
+    ru = run_up(fmu, model, out / "fmu_run_up", speed_from=max(w - 0.9, 0.1), speed_to=w + 0.9,
+                duration=4.0 if quick else 8.0, progress=progress)
+
+    diffs = [pair["2D"]["max_rel_diff_F_N_vs_library"], pair["3D"]["max_rel_diff_F_N_vs_library"],
+             ru["max_rel_diff_F_N_vs_library"], ru["max_rel_diff_disk_vs_library"]]
+    diffs += [v["max_real_max_rel_diff"] for v in qsum["vs_library"].values()]
+    res["harnesses"] = {"quasi_static": qsum, "transient": pair, "run_up": ru}
+    res["fmu_vs_library_max_rel_diff"] = float(max(diffs))
+    res["fmu_vs_library_note"] = (
+        "transients and run-up: max |F_N(FMU) - F_N(library)| / max |F_N(library)| with the library run under "
+        "the same zero-order hold (run_transient(hold=h)); quasi-static: max relative difference of the largest "
+        "eigenvalue real part over the cells where both found the same contact state (cells on another "
+        "branch are counted in harnesses.quasi_static.vs_library)")
+
+    try:
+        from .engine import run_coupled_scenario
+    except ImportError as exc:  # the engine coupling is part of the package; say so if it is broken
+        raise RuntimeError(f"fmu_src.engine is not importable: {exc}") from exc
+    _step("coupled engine scenario: LP spool FMU + contact FMU, fmpy master loop, SSP file")
+    coupled = run_coupled_scenario(out / "coupled", quick=quick, contact_fmu=fmu, fmu_dir=fmu_dir)
+    res["coupled_run"] = coupled
+    res["figures_extra"] = [
+        ("Contact and stability maps through the FMU (quasi-static sweeps)", "fmu_quasi_static/fmu_maps.png"),
+        ("Normal contact forces through the FMU, 2D vs 3D (paper Fig. 12)", "fmu_transient/fmu_contact_forces.png"),
+        ("Run-up through the first critical speed through the FMU", "fmu_run_up/run_up.png"),
+        *[(t, str(Path("coupled") / p)) for t, p in coupled.get("figures", [])],
+    ]
+    return res
+
+
+def _json(d: dict) -> str:
+    import json
+
+    return json.dumps(d, indent=1, default=float)
