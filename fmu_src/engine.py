@@ -1,0 +1,960 @@
+"""Engine coupling: the LP spool's speed as a second FMU, the coupled system as an SSP, an fmpy master.
+
+    python -m fmu_src.engine OUT_DIR [--full] [--contact-fmu F] [--spool-fmu F]
+
+Pieces:
+
+* :func:`build_spool_fmu` builds ``LPSpool.fmu`` from fmu_src/spool_slave.py with
+  pythonfmu (same recipe as fmu_src/build.py: the script is staged under a hashed
+  module name, ``lpspool_<hash>``, because every pythonfmu FMU in a process shares
+  one ``sys.modules``). The spool: J dOmega/dt = tau_drive(t) - c_w Omega^2 +
+  friction_torque, with a drive torque schedule that makes the rub-free spool follow
+  a half-cosine run-up Omega0 -> Omega1 exactly (see the slave's docstring).
+* :func:`write_ssp` writes an SSP 1.0 package (a zip): ``SystemStructure.ssd`` naming
+  the two FMUs (``resources/RotorCasingContact.fmu`` as component ``contact``,
+  ``resources/LPSpool.fmu`` as ``spool``), their connections (spool.Omega ->
+  contact.Omega, contact.friction_torque -> spool.friction_torque), units, a default
+  experiment, and one SSV parameter set per component (``resources/contact.ssv``,
+  ``resources/spool.ssv``). :func:`validate_ssp` checks it against the SSP 1.0 XML
+  schemas (vendored in fmu_src/schemas/ssp1, BSD-2-Clause, see the README there) and
+  checks that every connector, connection and parameter exists in the FMUs.
+* :func:`run_coupled` is a fixed-step co-simulation master on fmpy's FMU2Slave.
+  Exchange order (Jacobi): at each communication point t_k the inputs of both FMUs
+  are set from the outputs of both at t_k (contact.Omega <- spool.Omega(t_k),
+  spool.friction_torque <- contact.friction_torque(t_k)), then both step over
+  [t_k, t_k + h] with their inputs held (zero-order hold), then the outputs at
+  t_{k+1} are read. Each FMU thus sees the other one's output delayed by at most one
+  step; the friction torque recorded at t_k is exactly what the spool integrated over
+  [t_k, t_k + h], which is what the angular-momentum balance below uses.
+* :func:`run_coupled_scenario`: the run-up through the first critical speed with the
+  reference imbalance, without rub (g0 = 1 m: no contact) and with rub (g0 = 1 mm),
+  saved as NPZ, a PNG and summary.json next to the SSP.
+
+Balance (CoupledResult.momentum_balance): the drive torque is a schedule in time, the
+same in both runs, so the rub run and the rub-free run differ by
+
+    J (Omega_rub(T) - Omega_ref(T)) = sum_k tau_f,rub(t_k) h - sum_k tau_f,ref(t_k) h
+                                      - int (tau_w,rub - tau_w,ref) dt.
+
+The friction sums are exact (the torques were held over each step); the windage
+integral is a trapezoid rule on the recorded outputs (error O(h^2) of a small term);
+the spool's RK4 error is O(dt^4). The residual is therefore tiny next to the friction
+impulse (tests/test_engine.py states the tolerance).
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import io
+import json
+import math
+import shutil
+import sys
+import tempfile
+import time
+import zipfile
+from ctypes import byref
+from dataclasses import dataclass, field
+from functools import cache
+from pathlib import Path
+from xml.etree import ElementTree as ET
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+SPOOL_SCRIPT = HERE / "spool_slave.py"
+SCHEMA_DIR = HERE / "schemas" / "ssp1"
+SPOOL_ID = "LPSpool"
+CONTACT_ID = "RotorCasingContact"
+OMEGA_REF = 53.4  # rad/s, normalisation speed of the reference parameters
+FIRST_CRITICAL = 3.49 * OMEGA_REF  # rad/s, first critical speed of the reference model (about 186.4 rad/s)
+
+NS = {
+    "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
+    "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon",
+    "ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
+}
+MASTER_NS = "urn:rotorub:ssp:master"  # our annotation (communication step and exchange order)
+for _p, _u in NS.items():
+    ET.register_namespace(_p, _u)
+ET.register_namespace("rotorub", MASTER_NS)
+
+# the connections of the coupled system: (start element, start connector, end element, end connector)
+CONNECTIONS = (("spool", "Omega", "contact", "Omega"), ("contact", "friction_torque", "spool", "friction_torque"))
+# scenario: reference imbalance, reference clearance, rub disabled by a 1 m clearance
+ME_REF = 22.0e-3  # kg m
+G0_RUB = 1.0e-3  # m
+G0_NO_RUB = 1.0  # m
+
+
+class EngineError(RuntimeError):
+    """A build, SSP or co-simulation problem; ``messages`` holds what the FMUs logged."""
+
+    def __init__(self, what: str, messages=(), result=None):
+        self.messages = list(messages)
+        self.result = result  # the CoupledResult up to the failure, if any
+        detail = ("; ".join(self.messages)) if self.messages else ""
+        super().__init__(f"{what}: {detail}" if detail else what)
+
+
+# ---------------------------------------------------------------------------------------------- building
+def spool_defaults() -> dict:
+    """The spool FMU's default parameter values (module defaults of fmu_src/spool_slave.py)."""
+    from . import spool_slave
+
+    return dict(spool_slave.DEFAULTS)
+
+
+def build_spool_fmu(dest: str | Path = "fmus", **defaults) -> Path:
+    """Build ``dest/LPSpool.fmu``; keyword arguments override the parameters' start values
+    (J, c_w, Omega0, Omega1, t_ramp_start, t_ramp, dt_max). Needs pythonfmu."""
+    try:
+        from pythonfmu import FmuBuilder
+        from pythonfmu import __version__ as pythonfmu_version
+    except ImportError:
+        raise EngineError("pythonfmu is not installed: pip install 'rotorub[fmu]'") from None
+    values = spool_defaults()
+    unknown = sorted(set(defaults) - set(values))
+    if unknown:
+        raise EngineError(f"build_spool_fmu: unknown parameter(s) {', '.join(unknown)}; known: {', '.join(values)}")
+    for k, v in defaults.items():
+        v = float(v)
+        if not math.isfinite(v):
+            raise EngineError(f"build_spool_fmu: {k} = {v!r} is not finite")
+        values[k] = v
+    script_bytes = SPOOL_SCRIPT.read_bytes()
+    tag = hashlib.sha256(script_bytes + pythonfmu_version.encode()).hexdigest()[:10]
+    module_name = f"lpspool_{tag}"
+    dest = Path(dest)
+    dest.mkdir(parents=True, exist_ok=True)
+    out_file = dest / f"{SPOOL_ID}.fmu"
+    before = set(sys.modules)
+    path_before = list(sys.path)
+    with tempfile.TemporaryDirectory(prefix="rotorub_spool_") as tmp:
+        stage = Path(tmp) / "stage"
+        stage.mkdir()
+        script = stage / f"{module_name}.py"
+        script.write_bytes(script_bytes)
+        defaults_file = stage / "lpspool_defaults.json"
+        defaults_file.write_text(json.dumps(values, indent=1))
+        doc = Path(tmp) / "documentation"
+        doc.mkdir()
+        rows = "\n".join(f"<tr><td><code>{k}</code></td><td>{v!r}</td></tr>" for k, v in values.items())
+        (doc / "index.html").write_text(
+            "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>LPSpool</title></head><body>\n"
+            "<h1>LPSpool &mdash; low-pressure spool speed (FMI 2.0 co-simulation, pythonfmu)</h1>\n"
+            "<p>J dOmega/dt = tau_drive(t) - c_w Omega<sup>2</sup> + friction_torque. The drive torque schedule "
+            "tau_drive = J dOmega_s/dt + c_w Omega_s<sup>2</sup> makes the spool follow the half-cosine speed "
+            "schedule Omega_s(t) (Omega0 until t_ramp_start, Omega1 after t_ramp_start + t_ramp) exactly when no "
+            "external torque acts. Integration: RK4 on e = Omega - Omega_s with ceil(h/dt_max) substeps per "
+            "communication step, friction_torque held (zero-order hold). Rollback: fmi2Get/SetFMUstate and "
+            "serialization. Bad parameters or inputs: fmi2DoStep returns fmi2Discard after a log message naming "
+            "the variable (log with loggingOn = true).</p>\n<p>Needs a CPython 3.10+ host (pythonfmu); no other "
+            f"package.</p>\n<h2>Parameter start values</h2><table border=\"1\">\n{rows}\n</table></body></html>\n")
+        try:
+            FmuBuilder.build_FMU(script, dest=out_file, project_files=[defaults_file], documentation_folder=doc,
+                                 canGetAndSetFMUstate=True, canSerializeFMUstate=True)
+        finally:
+            for m in set(sys.modules) - before:
+                if m.split(".")[0] == module_name:
+                    sys.modules.pop(m, None)
+            sys.path[:] = path_before
+    return out_file
+
+
+def build_contact_fmu(dest: str | Path = "fmus") -> Path:
+    """``RotorCasingContact.fmu`` from fmu_src/build.py (reference parameters)."""
+    from .build import build_fmu
+
+    return Path(build_fmu(dest)["fmu"])
+
+
+# ---------------------------------------------------------------------------------------------- FMU descriptions
+@dataclass(frozen=True)
+class _Var:
+    name: str
+    type: str  # Real, Integer, Boolean, String, Enumeration
+    causality: str
+    variability: str
+    unit: str | None
+    start: str | None
+
+
+def _read_description(source) -> tuple[dict[str, _Var], dict[str, dict[str, float]], ET.Element]:
+    """(variables by name, unit name -> base-unit exponents, root) of an FMU file, FMU bytes or folder."""
+    if isinstance(source, bytes | bytearray):
+        with zipfile.ZipFile(io.BytesIO(source)) as z:
+            xml = z.read("modelDescription.xml")
+    else:
+        p = Path(source)
+        if p.is_dir():
+            xml = (p / "modelDescription.xml").read_bytes()
+        else:
+            with zipfile.ZipFile(p) as z:
+                xml = z.read("modelDescription.xml")
+    root = ET.fromstring(xml)
+    variables = {}
+    for sv in root.iter("ScalarVariable"):
+        typ = next(iter(sv))
+        variables[sv.get("name")] = _Var(sv.get("name"), typ.tag, sv.get("causality", "local"),
+                                         sv.get("variability", "continuous"), typ.get("unit"), typ.get("start"))
+    units = {}
+    for u in root.iter("Unit"):
+        bu = u.find("BaseUnit")
+        units[u.get("name")] = {} if bu is None else {k: float(v) for k, v in bu.attrib.items()}
+    return variables, units, root
+
+
+# ---------------------------------------------------------------------------------------------- SSP
+def _q(prefix: str, tag: str) -> str:
+    return f"{{{NS[prefix]}}}{tag}"
+
+
+def _fmt(v: float) -> str:
+    return repr(float(v))  # shortest round-tripping decimal: a valid xs:double
+
+
+def _connector(parent: ET.Element, var: _Var, kind: str) -> None:
+    c = ET.SubElement(parent, _q("ssd", "Connector"), name=var.name, kind=kind)
+    attrs = {"unit": var.unit} if (var.type == "Real" and var.unit) else {}
+    ET.SubElement(c, _q("ssc", var.type if var.type in ("Real", "Integer", "Boolean", "String") else "Real"), attrs)
+
+
+def _parameter_set(name: str, values: dict, variables: dict[str, _Var], units: dict) -> bytes:
+    root = ET.Element(_q("ssv", "ParameterSet"), version="1.0", name=name)
+    params = ET.SubElement(root, _q("ssv", "Parameters"))
+    used_units = []
+    for pname, value in values.items():
+        var = variables[pname]
+        p = ET.SubElement(params, _q("ssv", "Parameter"), name=pname)
+        if var.type == "String":
+            ET.SubElement(p, _q("ssv", "String"), value=str(value))
+        elif var.type == "Integer":
+            ET.SubElement(p, _q("ssv", "Integer"), value=str(int(value)))
+        else:
+            attrs = {"value": _fmt(value)}
+            if var.unit:
+                attrs["unit"] = var.unit
+                if var.unit not in used_units:
+                    used_units.append(var.unit)
+            ET.SubElement(p, _q("ssv", "Real"), attrs)
+    if used_units:
+        _units(ET.SubElement(root, _q("ssv", "Units")), used_units, units)
+    return _xml_bytes(root)
+
+
+def _units(parent: ET.Element, names, units: dict) -> None:
+    for name in names:
+        u = ET.SubElement(parent, _q("ssc", "Unit"), name=name)
+        exps = units.get(name, {})
+        ET.SubElement(u, _q("ssc", "BaseUnit"), {k: (str(int(v)) if k not in ("factor", "offset") else _fmt(v))
+                                                 for k, v in exps.items() if v != 0 or k == "factor"})
+
+
+def _xml_bytes(root: ET.Element) -> bytes:
+    ET.indent(root)
+    return b'<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="utf-8") + b"\n"
+
+
+def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, *, g0: float = G0_RUB,
+              imbalance: float = ME_REF, formulation: str = "3D", mode: str = "transient",
+              spool_params: dict | None = None, contact_params: dict | None = None, t_end: float = 5.0,
+              h: float = 1e-3, name: str = "RotorRubEngine") -> Path:
+    """Write the coupled system as an SSP 1.0 package; returns its path.
+
+    The package holds ``SystemStructure.ssd``, ``resources/RotorCasingContact.fmu``,
+    ``resources/LPSpool.fmu`` and the parameter sets ``resources/contact.ssv`` (g0,
+    formulation, mode, the imbalance input's value, ``contact_params``) and
+    ``resources/spool.ssv`` (the spool FMU's parameter start values updated by
+    ``spool_params``). The communication step and the exchange order of
+    :func:`run_coupled` are recorded in an annotation of the default experiment.
+    """
+    path = Path(path)
+    cvars, cunits, _ = _read_description(contact_fmu)
+    svars, sunits, _ = _read_description(spool_fmu)
+    all_units = {**sunits, **cunits}
+    for el, conn, _e, _c in CONNECTIONS:
+        vars_ = cvars if el == "contact" else svars
+        if conn not in vars_:
+            raise EngineError(f"write_ssp: the {el} FMU has no variable '{conn}'")
+    spool_values = {k: float(v.start) for k, v in svars.items() if v.causality == "parameter"}
+    for k, v in (spool_params or {}).items():
+        if k not in spool_values:
+            raise EngineError(f"write_ssp: spool parameter '{k}' unknown; known: {', '.join(spool_values)}")
+        spool_values[k] = float(v)
+    contact_values = {"g0": float(g0), "formulation": str(formulation), "mode": str(mode),
+                      "imbalance": float(imbalance)}
+    for k, v in (contact_params or {}).items():
+        if k not in cvars or cvars[k].causality not in ("parameter", "input"):
+            raise EngineError(f"write_ssp: contact parameter '{k}' is not a parameter or input of the contact FMU")
+        contact_values[k] = v
+
+    root = ET.Element(_q("ssd", "SystemStructureDescription"), version="1.0", name=name,
+                      description="Low-pressure spool of a turbofan coupled with the blade-tip/casing contact of its "
+                                  "fan: the spool's speed drives the contact model, the contact's friction torque "
+                                  "brakes the spool",
+                      generationTool="rotorub fmu_src.engine")
+    system = ET.SubElement(root, _q("ssd", "System"), name=name)
+    elements = ET.SubElement(system, _q("ssd", "Elements"))
+    comps = (
+        ("contact", f"resources/{CONTACT_ID}.fmu", cvars, contact_values,
+         [("Omega", "input"), ("imbalance", "input"), ("friction_torque", "output"), ("n_contact", "output"),
+          ("gap_min", "output")]),
+        ("spool", f"resources/{SPOOL_ID}.fmu", svars, spool_values,
+         [("friction_torque", "input"), ("Omega", "output"), ("drive_torque", "output"),
+          ("windage_torque", "output")]),
+    )
+    for cname, source, vars_, pvalues, conns in comps:
+        comp = ET.SubElement(elements, _q("ssd", "Component"), name=cname, type="application/x-fmu-sharedlibrary",
+                             source=source, implementation="CoSimulation")
+        connectors = ET.SubElement(comp, _q("ssd", "Connectors"))
+        declared = set()
+        for vname, kind in conns:
+            if vname in vars_:
+                _connector(connectors, vars_[vname], kind)
+                declared.add(vname)
+        for vname in pvalues:
+            if vname not in declared:
+                _connector(connectors, vars_[vname], "parameter" if vars_[vname].causality == "parameter" else "input")
+                declared.add(vname)
+        bindings = ET.SubElement(comp, _q("ssd", "ParameterBindings"))
+        ET.SubElement(bindings, _q("ssd", "ParameterBinding"), type="application/x-ssp-parameter-set",
+                      source=f"resources/{cname}.ssv")
+    connections = ET.SubElement(system, _q("ssd", "Connections"))
+    for se, sc, ee, ec in CONNECTIONS:
+        ET.SubElement(connections, _q("ssd", "Connection"), startElement=se, startConnector=sc, endElement=ee,
+                      endConnector=ec)
+    used = []
+    for _c, _s, vars_, pvalues, conns in comps:
+        for vname in [c for c, _k in conns] + list(pvalues):
+            u = vars_[vname].unit if vname in vars_ else None
+            if u and u not in used:
+                used.append(u)
+    _units(ET.SubElement(root, _q("ssd", "Units")), used, all_units)
+    de = ET.SubElement(root, _q("ssd", "DefaultExperiment"), startTime="0.0", stopTime=_fmt(t_end))
+    ann = ET.SubElement(ET.SubElement(de, _q("ssd", "Annotations")), _q("ssc", "Annotation"),
+                        type="org.rotorub.master")
+    ET.SubElement(ann, f"{{{MASTER_NS}}}FixedStepMaster", stepSize=_fmt(h), exchange="Jacobi",
+                  description="fixed communication step; at each communication point both FMUs get the other's "
+                              "outputs at that point, then both step (inputs held over the step)")
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("SystemStructure.ssd", _xml_bytes(root))
+        z.write(contact_fmu, f"resources/{CONTACT_ID}.fmu")
+        z.write(spool_fmu, f"resources/{SPOOL_ID}.fmu")
+        z.writestr("resources/contact.ssv", _parameter_set("contact", contact_values, cvars, all_units))
+        z.writestr("resources/spool.ssv", _parameter_set("spool", spool_values, svars, all_units))
+    return path
+
+
+@cache
+def _schema(name: str):
+    from lxml import etree
+
+    return etree.XMLSchema(etree.parse(str(SCHEMA_DIR / name)))
+
+
+def _schema_problems(xml: bytes, schema_file: str, where: str) -> tuple[list[str], object]:
+    from lxml import etree
+
+    try:
+        doc = etree.fromstring(xml)
+    except etree.XMLSyntaxError as exc:
+        return [f"{where}: not well-formed XML ({exc})"], None
+    schema = _schema(schema_file)
+    if schema.validate(doc):
+        return [], doc
+    return [f"{where}:{e.line}: {e.message}" for e in schema.error_log], doc
+
+
+def validate_ssp(path: str | Path) -> list[str]:
+    """Problems of an SSP package (empty list: valid).
+
+    Checks ``SystemStructure.ssd`` against the SSP 1.0 SystemStructureDescription
+    schema and every ``.ssv`` parameter set it binds against the
+    SystemStructureParameterValues schema (XML Schema 1.0, lxml), then that each
+    component's FMU is in the package, that its connectors exist in the FMU with a
+    compatible causality, that connections join declared connectors from an output
+    to an input, and that every bound parameter names a variable of the FMU.
+    """
+    problems: list[str] = []
+    try:
+        z = zipfile.ZipFile(path)
+    except (OSError, zipfile.BadZipFile) as exc:
+        return [f"{path}: not a readable zip file ({exc})"]
+    with z:
+        names = set(z.namelist())
+        if "SystemStructure.ssd" not in names:
+            return [f"{path}: SystemStructure.ssd missing (the default SSD of an SSP)"]
+        for n in sorted(names):
+            if n.endswith(".ssd") and n != "SystemStructure.ssd":  # variant SSDs
+                p, _ = _schema_problems(z.read(n), "SystemStructureDescription.xsd", n)
+                problems += p
+        p, doc = _schema_problems(z.read("SystemStructure.ssd"), "SystemStructureDescription.xsd",
+                                  "SystemStructure.ssd")
+        problems += p
+        if doc is None:
+            return problems
+        ns = {"ssd": NS["ssd"], "ssc": NS["ssc"], "ssv": NS["ssv"]}
+        connectors: dict[tuple[str, str], str] = {}
+        for sys_el in doc.iter(_q("ssd", "System")):
+            for c in sys_el.findall("ssd:Connectors/ssd:Connector", ns):
+                connectors[("", c.get("name"))] = c.get("kind")
+        for comp in doc.iter(_q("ssd", "Component")):
+            cname, src = comp.get("name"), comp.get("source")
+            if comp.get("type", "application/x-fmu-sharedlibrary") != "application/x-fmu-sharedlibrary":
+                continue
+            if src not in names:
+                problems.append(f"component '{cname}': source '{src}' is not in the package")
+                continue
+            try:
+                fvars, _, _ = _read_description(z.read(src))
+            except Exception as exc:  # noqa: BLE001 - reported
+                problems.append(f"component '{cname}': {src} is not a readable FMU ({exc})")
+                continue
+            for c in comp.findall("ssd:Connectors/ssd:Connector", ns):
+                vname, kind = c.get("name"), c.get("kind")
+                connectors[(cname, vname)] = kind
+                var = fvars.get(vname)
+                if var is None:
+                    problems.append(f"component '{cname}': connector '{vname}' is not a variable of {src}")
+                elif kind != var.causality:
+                    problems.append(f"component '{cname}': connector '{vname}' has kind '{kind}' but the FMU's "
+                                    f"variable has causality '{var.causality}'")
+            for b in comp.findall("ssd:ParameterBindings/ssd:ParameterBinding", ns):
+                bsrc = b.get("source")
+                if bsrc is None:
+                    sets = b.findall("ssd:ParameterValues/ssv:ParameterSet", ns)
+                    xmls = [ET.tostring(s) for s in sets]
+                else:
+                    if bsrc not in names:
+                        problems.append(f"component '{cname}': parameter set '{bsrc}' is not in the package")
+                        continue
+                    xmls = [z.read(bsrc)]
+                for xml in xmls:
+                    p, sdoc = _schema_problems(xml, "SystemStructureParameterValues.xsd", bsrc or "inline ssv")
+                    problems += p
+                    if sdoc is None:
+                        continue
+                    for par in sdoc.iter(_q("ssv", "Parameter")):
+                        pname = par.get("name")
+                        var = fvars.get(pname)
+                        if var is None or var.causality not in ("parameter", "input"):
+                            problems.append(f"component '{cname}': {bsrc or 'inline ssv'} sets '{pname}', which is "
+                                            f"not a parameter or input of {src}")
+        for con in doc.iter(_q("ssd", "Connection")):
+            s = (con.get("startElement") or "", con.get("startConnector"))
+            e = (con.get("endElement") or "", con.get("endConnector"))
+            for end, role, ok_kinds in ((s, "start", ("output", "parameter", "calculatedParameter", "inout")),
+                                        (e, "end", ("input", "parameter", "inout"))):
+                kind = connectors.get(end)
+                label = f"{end[0]}.{end[1]}" if end[0] else end[1]
+                if kind is None:
+                    problems.append(f"connection {s[0]}.{s[1]} -> {e[0]}.{e[1]}: {role} connector {label} is not "
+                                    "declared")
+                elif end[0] and kind not in ok_kinds:
+                    problems.append(f"connection {s[0]}.{s[1]} -> {e[0]}.{e[1]}: {role} connector {label} has kind "
+                                    f"'{kind}'")
+    return problems
+
+
+def ssp_contents(path: str | Path) -> dict:
+    """What an SSP names: {"components": {name: source}, "connections": [(se, sc, ee, ec), ...]}."""
+    with zipfile.ZipFile(path) as z:
+        root = ET.fromstring(z.read("SystemStructure.ssd"))
+    comps = {c.get("name"): c.get("source") for c in root.iter(_q("ssd", "Component"))}
+    conns = [(c.get("startElement"), c.get("startConnector"), c.get("endElement"), c.get("endConnector"))
+             for c in root.iter(_q("ssd", "Connection"))]
+    return {"components": comps, "connections": conns}
+
+
+# ---------------------------------------------------------------------------------------------- master
+def _trapezoid(y: np.ndarray, x: np.ndarray) -> float:
+    """Trapezoid rule (np.trapezoid is numpy >= 2 only)."""
+    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(x)))
+
+
+class _Log:
+    """fmi2CallbackLogger collecting (status, message)."""
+
+    def __init__(self):
+        self.records: list[tuple[int, str]] = []
+
+    def __call__(self, _env, _instance, status, _category, message) -> None:
+        text = message.decode("utf-8", "replace") if isinstance(message, bytes) else str(message)
+        self.records.append((int(status), text))
+
+    def problems(self, since: int = 0, level: int = 1) -> list[str]:
+        return [m for s, m in self.records[since:] if s >= level]
+
+
+class FmuInstance:
+    """One co-simulation instance through fmpy's FMU2Slave, logging on, variables addressed by name.
+
+    pythonfmu forwards the slave's log messages only when the instance is created with
+    loggingOn = true; they are kept in ``log.records`` as (status, message). ``fmu`` is
+    the fmpy FMU2Slave (its calls raise FMICallException on fmi2Discard and worse).
+    """
+
+    def __init__(self, fmu: str | Path, instance_name: str):
+        from fmpy import extract, read_model_description
+        from fmpy.fmi2 import (
+            FMU2Slave,
+            fmi2CallbackAllocateMemoryTYPE,
+            fmi2CallbackFreeMemoryTYPE,
+            fmi2CallbackFunctions,
+            fmi2CallbackLoggerTYPE,
+        )
+
+        fmu = Path(fmu)
+        self._tmp = None
+        if fmu.is_dir():
+            unzip = str(fmu)
+        else:
+            unzip = extract(str(fmu))
+            self._tmp = unzip
+        self.md = read_model_description(unzip)
+        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
+        self.var = {v.name: v for v in self.md.modelVariables}
+        self.log = _Log()
+        from fmpy import calloc, free
+
+        cb = fmi2CallbackFunctions()
+        cb.logger = fmi2CallbackLoggerTYPE(self.log)
+        cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        try:
+            from fmpy.logging import addLoggerProxy
+
+            addLoggerProxy(byref(cb))
+        except Exception:  # noqa: BLE001 - messages without printf formatting still arrive
+            pass
+        self._cb = cb
+        self.name = instance_name
+        self._alive = False
+        try:
+            self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=unzip,
+                                 modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=instance_name)
+            self.fmu.instantiate(callbacks=cb, loggingOn=True)
+        except Exception as exc:
+            self.close()
+            raise EngineError(f"{instance_name}: {fmu} could not be instantiated ({exc})",
+                              self.log.problems()) from exc
+        self._alive = True
+
+    def set(self, **values) -> None:
+        for k, v in values.items():
+            if k not in self.vr:
+                raise EngineError(f"{self.name}: no variable '{k}'")
+            typ = self.var[k].type
+            if typ == "String":
+                self.fmu.setString([self.vr[k]], [str(v)])
+            elif typ in ("Integer", "Enumeration"):
+                self.fmu.setInteger([self.vr[k]], [int(v)])
+            elif typ == "Boolean":
+                self.fmu.setBoolean([self.vr[k]], [bool(v)])
+            else:
+                self.fmu.setReal([self.vr[k]], [float(v)])
+
+    def get(self, name: str):
+        typ = self.var[name].type
+        if typ == "Real":
+            return self.fmu.getReal([self.vr[name]])[0]
+        if typ in ("Integer", "Enumeration"):
+            return self.fmu.getInteger([self.vr[name]])[0]
+        if typ == "String":
+            return self.fmu.getString([self.vr[name]])[0].decode()
+        return self.fmu.getBoolean([self.vr[name]])[0]
+
+    def initialize(self, t0: float, t_end: float, **start) -> None:
+        n0 = len(self.log.records)
+        self.fmu.setupExperiment(startTime=t0, stopTime=t_end)
+        self.fmu.enterInitializationMode()
+        self.set(**start)
+        self.fmu.exitInitializationMode()
+        errs = self.log.problems(n0, level=3)  # fmi2Error: a configuration the FMU refuses
+        if errs:
+            raise EngineError(f"{self.name}: initialization refused", errs)
+
+    def close(self) -> None:
+        if self._alive:
+            self._alive = False
+            try:
+                self.fmu.terminate()
+            except Exception:  # noqa: BLE001 - terminating after a failure may itself fail
+                pass
+            self.fmu.freeInstance()
+        if self._tmp:
+            shutil.rmtree(self._tmp, ignore_errors=True)
+            self._tmp = None
+
+
+@dataclass
+class CoupledResult:
+    """Records of a coupled run at the communication points t_0 .. t_N (N + 1 rows).
+
+    ``friction_torque[k]`` is the contact's output at t_k, which the spool held over
+    [t_k, t_k + h] (so the last row was not applied). ``F_N`` is (N + 1, blades).
+    """
+
+    t: np.ndarray
+    omega: np.ndarray
+    omega_schedule: np.ndarray
+    drive_torque: np.ndarray
+    windage_torque: np.ndarray
+    friction_torque: np.ndarray
+    F_N: np.ndarray
+    n_contact: np.ndarray
+    gap_min: np.ndarray
+    contact_status: np.ndarray
+    spool_status: np.ndarray
+    meta: dict = field(default_factory=dict)
+
+    @property
+    def h(self) -> float:
+        return float(self.meta["h"])
+
+    @property
+    def J(self) -> float:
+        return float(self.meta["J"])
+
+    def friction_impulse(self) -> float:
+        """Angular impulse the spool received from the contact [N m s]: sum of held torques x h."""
+        return float(np.sum(self.friction_torque[:-1]) * self.h)
+
+    def friction_energy(self) -> float:
+        """Energy dissipated by the contact friction [J] (positive), trapezoid over each held step."""
+        w = 0.5 * (self.omega[:-1] + self.omega[1:])
+        return float(-np.sum(self.friction_torque[:-1] * w) * self.h)
+
+    def momentum_balance(self, reference: CoupledResult) -> dict:
+        """J (Omega(T) - Omega_ref(T)) against the torque impulses (see the module docstring)."""
+        if self.t.shape != reference.t.shape or not np.array_equal(self.t, reference.t):
+            raise ValueError("momentum_balance: the two runs must share their communication points")
+        lhs = self.J * (self.omega[-1] - reference.omega[-1])
+        friction = self.friction_impulse() - reference.friction_impulse()
+        windage = float(_trapezoid(self.windage_torque - reference.windage_torque, self.t))
+        drive = float(_trapezoid(self.drive_torque - reference.drive_torque, self.t))
+        rhs = friction - windage + drive
+        return {"J_delta_omega_N_m_s": float(lhs), "friction_impulse_N_m_s": friction,
+                "windage_impulse_difference_N_m_s": windage, "drive_impulse_difference_N_m_s": drive,
+                "residual_N_m_s": float(lhs - rhs),
+                "relative_residual": float(abs(lhs - rhs) / max(abs(friction), 1e-300))}
+
+    def energy_balance(self, reference: CoupledResult) -> dict:
+        """J/2 (Omega(T)^2 - Omega_ref(T)^2) against the work of drive, windage and friction (trapezoid)."""
+        lhs = 0.5 * self.J * (self.omega[-1] ** 2 - reference.omega[-1] ** 2)
+
+        def work(r):
+            w_mid = 0.5 * (r.omega[:-1] + r.omega[1:])
+            drive = float(_trapezoid(r.drive_torque * r.omega, r.t))
+            windage = float(_trapezoid(r.windage_torque * r.omega, r.t))
+            friction = float(np.sum(r.friction_torque[:-1] * w_mid) * r.h)
+            return drive, windage, friction
+
+        d1, w1, f1 = work(self)
+        d0, w0, f0 = work(reference)
+        rhs = (d1 - d0) - (w1 - w0) + (f1 - f0)
+        return {"J_half_delta_omega2_J": float(lhs), "friction_work_J": f1 - f0, "drive_work_difference_J": d1 - d0,
+                "windage_work_difference_J": w1 - w0, "residual_J": float(lhs - rhs),
+                "relative_residual": float(abs(lhs - rhs) / max(abs(f1 - f0), 1e-300))}
+
+    def summary(self, reference: CoupledResult | None = None) -> dict:
+        """Key numbers; with the rub-free ``reference`` run, the speed dip and the balances too."""
+        s = {
+            "t_end_s": float(self.t[-1]), "h_s": self.h, "steps": int(len(self.t) - 1),
+            "g0_m": self.meta.get("g0"), "imbalance_kg_m": self.meta.get("imbalance"),
+            "formulation": self.meta.get("formulation"), "exchange": self.meta.get("exchange"),
+            "max_contact_force_N": float(np.max(self.F_N)) if self.F_N.size else 0.0,
+            "max_n_contact": int(np.max(self.n_contact)) if self.n_contact.size else 0,
+            "min_friction_torque_N_m": float(np.min(self.friction_torque)),
+            "friction_impulse_N_m_s": self.friction_impulse(),
+            "friction_energy_J": self.friction_energy(),
+            "contact_time_s": float(np.count_nonzero(self.n_contact[:-1] > 0) * self.h),
+            "omega_end_rad_s": float(self.omega[-1]), "wall_time_s": self.meta.get("wall_time_s"),
+            "first_step_s": self.meta.get("first_step_s"),
+        }
+        if np.any(self.n_contact > 0):
+            k = int(np.argmax(np.max(self.F_N, axis=1)))
+            s["t_max_contact_force_s"] = float(self.t[k])
+            s["omega_at_max_contact_force_rad_s"] = float(self.omega[k])
+        if reference is not None:
+            if not np.array_equal(self.t, reference.t):
+                raise ValueError("summary: the reference run must share the communication points")
+            short = reference.omega - self.omega
+            k = int(np.argmax(short))
+            s["min_spool_speed_dip_rad_s"] = float(short[k])  # largest shortfall against the rub-free run
+            s["t_speed_dip_s"] = float(self.t[k])
+            s["omega_end_shortfall_rad_s"] = float(short[-1])
+            s["momentum_balance"] = self.momentum_balance(reference)
+            s["energy_balance"] = self.energy_balance(reference)
+        return s
+
+    def save_npz(self, path: str | Path) -> Path:
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        np.savez_compressed(path, t=self.t, omega=self.omega, omega_schedule=self.omega_schedule,
+                            drive_torque=self.drive_torque, windage_torque=self.windage_torque,
+                            friction_torque=self.friction_torque, F_N=self.F_N, n_contact=self.n_contact,
+                            gap_min=self.gap_min, contact_status=self.contact_status,
+                            spool_status=self.spool_status, meta=json.dumps(self.meta))
+        return path
+
+    @classmethod
+    def load_npz(cls, path: str | Path) -> CoupledResult:
+        with np.load(path) as d:
+            arrays = {k: d[k] for k in d.files if k != "meta"}
+            meta = json.loads(str(d["meta"]))
+        return cls(meta=meta, **arrays)
+
+    def plot(self, path: str | Path, reference: CoupledResult | None = None) -> Path:
+        """PNG: spin speed (with the rub-free run), speed shortfall, friction torque, contact forces."""
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fig, ax = plt.subplots(4, 1, figsize=(9, 11), sharex=True)
+        t = self.t
+        if reference is not None:
+            ax[0].plot(reference.t, reference.omega, "k--", lw=1.2, label="no rub (follows the drive schedule)")
+        ax[0].plot(t, self.omega, "C3", lw=1.2, label=f"with rub (g0 = {self.meta.get('g0', float('nan')) * 1e3:g} mm)")
+        ax[0].axhline(FIRST_CRITICAL, color="0.5", lw=0.8, ls=":")
+        ax[0].text(t[0], FIRST_CRITICAL, " first critical speed", va="bottom", fontsize=8, color="0.4")
+        ax[0].set_ylabel("spool speed Omega [rad/s]")
+        ax[0].legend(loc="lower right", fontsize=8)
+        ax[0].set_title(f"LP spool run-up through the first critical speed, imbalance "
+                        f"{self.meta.get('imbalance', float('nan')) * 1e3:g} kg mm, "
+                        f"{self.meta.get('formulation', '')} contact, h = {self.h * 1e3:g} ms "
+                        f"({self.meta.get('exchange')} exchange)",
+                        fontsize=9)
+        if reference is not None:
+            ax[1].plot(t, reference.omega - self.omega, "C3", lw=1.2)
+            ax[1].set_ylabel("shortfall Omega_no rub - Omega [rad/s]")
+        else:
+            ax[1].plot(t, self.omega_schedule - self.omega, "C3", lw=1.2)
+            ax[1].set_ylabel("Omega_schedule - Omega [rad/s]")
+        ax[2].plot(t, self.friction_torque, "C0", lw=0.8)
+        ax[2].set_ylabel("friction torque [N m]")
+        if self.F_N.size:
+            ax[3].plot(t, self.F_N, lw=0.5, alpha=0.6)
+            ax[3].plot(t, self.F_N.max(axis=1), "k", lw=0.8, label="max over blades")
+            ax[3].legend(loc="upper left", fontsize=8)
+        ax[3].set_ylabel("normal contact force per blade [N]")
+        ax[3].set_xlabel("time [s]")
+        for a in ax:
+            a.grid(alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        return path
+
+
+def run_coupled(contact_fmu: str | Path, spool_fmu: str | Path, t_end: float, h: float = 1e-3,
+                g0: float = G0_RUB, imbalance: float = ME_REF, formulation: str = "3D", progress: bool = False,
+                spool_params: dict | None = None, contact_params: dict | None = None,
+                t_start: float = 0.0) -> CoupledResult:
+    """Fixed-step co-simulation of the contact FMU and the spool FMU (fmpy FMU2Slave, Jacobi exchange).
+
+    ``contact_fmu``/``spool_fmu``: .fmu files or extracted folders. ``g0`` [m] the
+    clearance (1 m disables the rub), ``imbalance`` [kg m] held constant, ``formulation``
+    '2D' or '3D' (contact mode 'transient'), ``spool_params`` the spool's parameters
+    (J, c_w, Omega0, Omega1, t_ramp_start, t_ramp, dt_max), ``contact_params`` further
+    contact parameters (k_r, mu, dt_max, ...). A refused step raises :class:`EngineError`
+    with the FMUs' messages and the records so far (``exc.result``).
+
+    Exchange (Jacobi), for k = 0 .. N-1: contact.Omega <- spool.Omega(t_k),
+    spool.friction_torque <- contact.friction_torque(t_k); fmi2DoStep(t_k, h) on the contact,
+    then on the spool (independent: either order gives the same result); read both FMUs'
+    outputs at t_{k+1}. Initialization: the spool first, its Omega(t_0) is the contact's
+    initial Omega.
+
+    Note: the contact FMU's first step in a process compiles its numba kernels (seconds);
+    ``meta["first_step_s"]`` reports it.
+    """
+    if not (math.isfinite(h) and h > 0 and math.isfinite(t_end) and t_end > t_start):
+        raise EngineError(f"run_coupled: need h > 0 and t_end > t_start (h = {h!r}, t_end = {t_end!r})")
+    n = int(round((t_end - t_start) / h))
+    if n < 1 or abs(n * h - (t_end - t_start)) > 1e-9 * max(1.0, t_end - t_start):
+        raise EngineError(f"run_coupled: t_end - t_start = {t_end - t_start!r} s is not a whole number of steps "
+                          f"h = {h!r} s")
+    from fmpy.fmi1 import FMICallException
+    from fmpy.fmi2 import fmi2Integer, fmi2Real, fmi2True, fmi2ValueReference
+
+    wall0 = time.perf_counter()
+    spool = FmuInstance(spool_fmu, "spool")
+    contact = None
+    try:
+        contact = FmuInstance(contact_fmu, "contact")
+        spool.initialize(t_start, t_end, **(spool_params or {}))
+        omega0 = spool.get("Omega")
+        cstart = {"formulation": formulation, "mode": "transient", "g0": g0, "imbalance": imbalance,
+                  "Omega": omega0, **(contact_params or {})}
+        contact.initialize(t_start, t_end, **cstart)
+        J = spool.get("J")
+        nb = sum(1 for name in contact.vr if name.startswith("blade[") and name.endswith("].F_N"))
+
+        def arr(ctype, values):
+            return (ctype * len(values))(*values)
+
+        s_out_names = ["Omega", "Omega_schedule", "drive_torque", "windage_torque"]
+        c_out_names = ["friction_torque", "gap_min"] + [f"blade[{j}].F_N" for j in range(1, nb + 1)]
+        s_vr_out = arr(fmi2ValueReference, [spool.vr[k] for k in s_out_names])
+        c_vr_out = arr(fmi2ValueReference, [contact.vr[k] for k in c_out_names])
+        s_vr_int = arr(fmi2ValueReference, [spool.vr["status"]])
+        c_vr_int = arr(fmi2ValueReference, [contact.vr["n_contact"], contact.vr["status"]])
+        s_vals, c_vals = (fmi2Real * len(s_out_names))(), (fmi2Real * len(c_out_names))()
+        s_ints, c_ints = (fmi2Integer * 1)(), (fmi2Integer * 2)()
+        c_vr_in = arr(fmi2ValueReference, [contact.vr["Omega"], contact.vr["imbalance"]])
+        s_vr_in = arr(fmi2ValueReference, [spool.vr["friction_torque"]])
+        c_in, s_in = (fmi2Real * 2)(), (fmi2Real * 1)()
+        sf, cf = spool.fmu, contact.fmu
+        sc, cc = sf.component, cf.component
+
+        t = t_start + np.arange(n + 1) * h
+        S = np.full((n + 1, len(s_out_names)), np.nan)
+        C = np.full((n + 1, len(c_out_names)), np.nan)
+        I_s = np.zeros((n + 1, 1), dtype=np.int64)
+        I_c = np.zeros((n + 1, 2), dtype=np.int64)
+
+        def read(k):
+            sf.fmi2GetReal(sc, s_vr_out, len(s_out_names), s_vals)
+            cf.fmi2GetReal(cc, c_vr_out, len(c_out_names), c_vals)
+            sf.fmi2GetInteger(sc, s_vr_int, 1, s_ints)
+            cf.fmi2GetInteger(cc, c_vr_int, 2, c_ints)
+            S[k] = s_vals
+            C[k] = c_vals
+            I_s[k] = s_ints
+            I_c[k] = c_ints
+
+        read(0)
+        meta = {"h": h, "g0": g0, "imbalance": imbalance, "formulation": formulation, "J": J,
+                "exchange": "Jacobi", "t_start": t_start, "t_end": t_end,
+                "spool": {k: spool.get(k) for k in ("J", "c_w", "Omega0", "Omega1", "t_ramp_start", "t_ramp",
+                                                    "dt_max")},
+                "contact_fmu": str(contact_fmu), "spool_fmu": str(spool_fmu)}
+        bar = None
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=n, desc=f"coupled g0={g0:g} m", unit="step", mininterval=1.0)
+        first = None
+        done = 0
+        failure = None
+        loop0 = time.perf_counter()
+        for k in range(n):
+            tk = float(t[k])
+            # Jacobi: both inputs from the outputs at t_k, held over [t_k, t_k + h]
+            c_in[0] = S[k, 0]
+            c_in[1] = imbalance
+            s_in[0] = C[k, 0]
+            cf.fmi2SetReal(cc, c_vr_in, 2, c_in)
+            sf.fmi2SetReal(sc, s_vr_in, 1, s_in)
+            n_c, n_s = len(contact.log.records), len(spool.log.records)
+            t0 = time.perf_counter()
+            try:
+                cf.fmi2DoStep(cc, tk, h, fmi2True)
+                sf.fmi2DoStep(sc, tk, h, fmi2True)
+            except FMICallException as exc:
+                msgs = [f"contact: {m}" for m in contact.log.problems(n_c)] + \
+                       [f"spool: {m}" for m in spool.log.problems(n_s)]
+                failure = (f"run_coupled: step at t = {tk:g} s refused ({exc})", msgs)
+                break
+            if first is None:
+                first = time.perf_counter() - t0
+            read(k + 1)
+            done = k + 1
+            if bar is not None:
+                bar.update(1)
+        if bar is not None:
+            bar.close()
+        meta["loop_time_s"] = time.perf_counter() - loop0
+        meta["first_step_s"] = first
+        meta["wall_time_s"] = time.perf_counter() - wall0
+        meta["steps_done"] = done
+        m = done + 1
+        result = CoupledResult(
+            t=t[:m], omega=S[:m, 0], omega_schedule=S[:m, 1], drive_torque=S[:m, 2], windage_torque=S[:m, 3],
+            friction_torque=C[:m, 0], gap_min=C[:m, 1], F_N=C[:m, 2:], n_contact=I_c[:m, 0],
+            contact_status=I_c[:m, 1], spool_status=I_s[:m, 0], meta=meta)
+        if failure is not None:
+            raise EngineError(failure[0], failure[1], result=result)
+        return result
+    finally:
+        if contact is not None:
+            contact.close()
+        spool.close()
+
+
+# ---------------------------------------------------------------------------------------------- scenario
+def scenario_settings(quick: bool = True) -> dict:
+    """The run-up scenario: 2.8 -> 4.2 x omega_ref (the first critical speed, about 3.49 x omega_ref, halfway),
+    reference imbalance 22 kg mm held from t = 0, 3D contact, h = 1 ms. quick: 4 s run-up; full: 6 s."""
+    ramp = 4.0 if quick else 6.0
+    return {"h": 1e-3, "t_end": 0.5 + ramp + 0.5, "formulation": "3D", "imbalance": ME_REF, "g0_rub": G0_RUB,
+            "g0_no_rub": G0_NO_RUB,
+            "spool_params": {"Omega0": 149.52, "Omega1": 224.28, "t_ramp_start": 0.5,
+                             "t_ramp": ramp}}
+
+
+def run_coupled_scenario(out_dir: str | Path, quick: bool = True, contact_fmu: str | Path | None = None,
+                         spool_fmu: str | Path | None = None, progress: bool = False,
+                         fmu_dir: str | Path | None = None) -> dict:
+    """Build the FMUs (unless given), write and validate the SSP, run the rub-free and the rub cases,
+    and save ``no_rub.npz``, ``rub.npz``, ``coupled_runup.png``, ``summary.json`` in ``out_dir``."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    cfg = scenario_settings(quick)
+    t0 = time.perf_counter()
+    fmu_dir = Path(fmu_dir) if fmu_dir else out / "fmus"
+    contact_fmu = Path(contact_fmu) if contact_fmu else build_contact_fmu(fmu_dir)
+    spool_fmu = Path(spool_fmu) if spool_fmu else build_spool_fmu(fmu_dir)
+    build_s = time.perf_counter() - t0
+    ssp = write_ssp(out / "RotorRubEngine.ssp", contact_fmu, spool_fmu, g0=cfg["g0_rub"], imbalance=cfg["imbalance"],
+                    formulation=cfg["formulation"], spool_params=cfg["spool_params"], t_end=cfg["t_end"], h=cfg["h"])
+    problems = validate_ssp(ssp)
+    if problems:
+        raise EngineError(f"{ssp}: the SSP does not validate", problems)
+    common = {"t_end": cfg["t_end"], "h": cfg["h"], "imbalance": cfg["imbalance"], "formulation": cfg["formulation"],
+              "spool_params": cfg["spool_params"], "progress": progress}
+    ref = run_coupled(contact_fmu, spool_fmu, g0=cfg["g0_no_rub"], **common)
+    rub = run_coupled(contact_fmu, spool_fmu, g0=cfg["g0_rub"], **common)
+    ref.save_npz(out / "no_rub.npz")
+    rub.save_npz(out / "rub.npz")
+    rub.plot(out / "coupled_runup.png", reference=ref)
+    summary = rub.summary(reference=ref)
+    summary.update({"no_rub_max_deviation_from_schedule_rad_s": float(np.max(np.abs(ref.omega - ref.omega_schedule))),
+                    "no_rub_max_friction_torque_N_m": float(np.max(np.abs(ref.friction_torque))),
+                    "no_rub_wall_time_s": ref.meta["wall_time_s"], "build_time_s": build_s, "ssp": str(ssp),
+                    "ssp_valid": True, "contact_fmu": str(contact_fmu), "spool_fmu": str(spool_fmu),
+                    "quick": quick})
+    (out / "summary.json").write_text(json.dumps(summary, indent=1))
+    summary["figures"] = [("Coupled run-up: spool speed with and without rub, friction torque, contact forces",
+                           "coupled_runup.png")]
+    return summary
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("out_dir")
+    ap.add_argument("--full", action="store_true", help="6 s run-up instead of 4 s")
+    ap.add_argument("--contact-fmu", default=None, help="use this RotorCasingContact.fmu instead of building one")
+    ap.add_argument("--spool-fmu", default=None, help="use this LPSpool.fmu instead of building one")
+    ap.add_argument("--progress", action="store_true")
+    ns = ap.parse_args(argv)
+    try:
+        s = run_coupled_scenario(ns.out_dir, quick=not ns.full, contact_fmu=ns.contact_fmu, spool_fmu=ns.spool_fmu,
+                                 progress=ns.progress)
+    except EngineError as exc:
+        print(f"engine: error: {exc}", file=sys.stderr)
+        return 2
+    print(json.dumps(s, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
