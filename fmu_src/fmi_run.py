@@ -95,7 +95,7 @@ class Slave:
         )
 
         self._own_dir = unzip_dir is None
-        self.unzip_dir = str(extract(str(fmu)) if unzip_dir is None else unzip_dir)
+        self.unzip_dir = str(Path(extract(str(fmu)) if unzip_dir is None else unzip_dir).resolve())
         md = read_model_description(self.unzip_dir)
         self.model_description = md
         self.variables = {v.name: v for v in md.modelVariables}

@@ -38,7 +38,7 @@ def _names(n_blades: int, what: str) -> list[str]:
 def _extract(fmu: str | Path, where: str | Path) -> str:
     from fmpy import extract
 
-    return extract(str(fmu), str(where))
+    return extract(str(fmu), str(Path(where).resolve()))
 
 
 def _progress(total: int, desc: str, show: bool):

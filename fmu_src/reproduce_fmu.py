@@ -31,7 +31,7 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
     # sections 4-5 through the FMU: a coarser grid than the library's own maps in --quick
     w = summary["response"]["critical_speeds"][0]
     gmax = 1.6 * summary["response"]["peak_amplitudes_m"][0]
-    n_sp, n_g = (16, 12) if quick else (60, 40)
+    n_sp, n_g = (20, 16) if quick else (60, 40)
     speeds = np.linspace(max(w - 0.8, 0.05), w + 0.8, n_sp)
     g0s = gmax * np.linspace(0.0, 1.0, n_g) ** 2
     _step(f"quasi-static sweeps through the FMU ({n_sp} speeds x {n_g} clearances x 2D/3D) vs the library maps")
