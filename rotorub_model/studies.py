@@ -124,7 +124,7 @@ def pick_transient_point(model: Model, stab_dir: str | Path | None = None, quick
     q = linear_response(model, speed * model.params.normalisation.omega_ref)
     closure = float(-make_contact(model, "3D", g0=0.0).gaps(q).min())
     found = []
-    for g0 in np.linspace(0.0, max(closure, 0.0), 41)[1:-1]:
+    for g0 in np.linspace(0.0, max(closure, 0.0), 161)[1:-1]:  # qualifying windows are ~0.02 mm wide
         st = point_status(model, speed, float(g0))
         if _qualifies(st):
             n2, n3 = st["2D"]["static"].n_contact, st["3D"]["static"].n_contact
@@ -188,6 +188,10 @@ class TransientStudy:
         fr3 = r3.outputs["fraction"][i3]
         touching = fr3[fr3 > 0]
         partial = touching[touching < 1.0 - 1e-9]
+        # the state the 3D run settles on (last record): at exactly 1 s the ramp has just ended
+        # and the blades still ring, so the chord fraction there is a snapshot of a transient
+        fr_end = r3.outputs["fraction"][-1] if len(r3.t) else np.zeros(0)
+        touching_end = fr_end[fr_end > 0]
         st2 = self.statics["2D"]["static"]
         g2 = growth_after_ramp(r2, st2.q) if st2.converged else {"rate_per_s": None, "factor": None}
         g3 = growth_after_ramp(r3, st3.q) if st3.converged else {"rate_per_s": None, "factor": None}
@@ -203,8 +207,10 @@ class TransientStudy:
             "settled_3d": settled(r3, st3.q) if st3.converged else False,
             "blades_in_contact_2d_at_1s": r2.blades_in_contact(i2),
             "blades_in_contact_3d_at_1s": r3.blades_in_contact(i3),
-            "partial_chord_fraction_3d": _partial(partial, touching),
+            "partial_chord_fraction_3d": _partial(touching_end[touching_end < 1.0 - 1e-9], touching_end),
+            "partial_chord_fraction_3d_at_1s": _partial(partial, touching),
             "chord_fractions_3d_at_1s": fr3,
+            "chord_fractions_3d_settled": fr_end,
             "max_force_at_1s_N": {"2D": float(r2.outputs["F_N"][i2].max()), "3D": float(r3.outputs["F_N"][i3].max())},
             "static_2d": {"blades_in_contact": self.statics["2D"]["static"].n_contact,
                           "max_real_part": _max_real(self.statics["2D"])},
