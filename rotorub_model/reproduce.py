@@ -44,8 +44,8 @@ def fact6(tr: dict) -> list[dict]:
     a = {
         "id": "6a",
         "statement": "transient at a point with unstable 2D / stable 3D static solutions: 2D diverges after the "
-                     "ramp, 3D settles on its static solution; three blades touch at 1 s, the third one, in the 3D state reached, "
-                     "only partly along its chord",
+                     "ramp, 3D settles on its static solution; three blades touch at 1 s, the third one, in "
+                     "the 3D state reached, only partly along its chord",
         "paper": {"speed": 3.3, "g0_mm": 0.8, "blades_at_1s": 3, "partial_chord_fraction_3d": 0.88},
         "ours": {k: tr[k] for k in ("speed", "g0_mm", "diverged_2d", "settled_3d", "blades_in_contact_2d_at_1s",
                                     "blades_in_contact_3d_at_1s", "partial_chord_fraction_3d")},
