@@ -200,13 +200,26 @@ def run_fmu_transient(fmu: str | Path, unzip: str, formulation: str, g0: float, 
                   rec[:m, 2 * nb + 1:2 * nb + 3], status[: m + (1 if m < n else 0)], time.perf_counter() - t0)
 
 
+def force_growth(r: FMURun, t_from: float = 2.0, window: float = 2.0) -> float | None:
+    """Growth of the oscillation of the total normal force after the ramp: its peak-to-peak range
+    over the last ``window`` seconds divided by that over [t_from, t_from + window]. The FMU's
+    counterpart of the library's state-envelope growth (studies.growth_after_ramp), with the same
+    verdict threshold (10x = diverged); None if the run is too short."""
+    if len(r.t) == 0 or r.t[-1] < t_from + 2 * window:
+        return None
+    total = r.F_N.sum(axis=1)
+    first = (r.t >= t_from) & (r.t < t_from + window)
+    last = r.t >= r.t[-1] - window
+    return float(np.ptp(total[last]) / max(np.ptp(total[first]), 1e-9))
+
+
 def _rel_diff(a: np.ndarray, b: np.ndarray) -> float:
     m = min(len(a), len(b))
     scale = max(float(np.abs(b[:m]).max()) if m else 0.0, 1e-30)
     return float(np.abs(a[:m] - b[:m]).max() / scale) if m else 0.0
 
 
-def _plot_forces(runs: dict[str, FMURun], path: Path, title: str) -> Path:
+def _plot_forces(runs: dict[str, FMURun], path: Path, title: str, diverged: dict[str, bool]) -> Path:
     from rotorub_model.results import pyplot
 
     plt = pyplot()
@@ -216,8 +229,7 @@ def _plot_forces(runs: dict[str, FMURun], path: Path, title: str) -> Path:
             if r.F_N[:, j].max() > 0:
                 ax.plot(r.t, r.F_N[:, j], lw=0.8, label=f"blade {j + 1}")
         ax.set_ylabel("F_N [N]")
-        diverged = len(r.status) > len(r.t) and r.status[-1] == 1
-        ax.set_title(f"{f}: {title}" + (" — diverged" if diverged else ""))
+        ax.set_title(f"{f}: {title}" + (" — diverged" if diverged[f] else ""))
         ax.grid(alpha=0.3)
         if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=7, ncol=3)
@@ -252,8 +264,10 @@ def transient_pair(fmu: str | Path, model, speed: float, g0: float, out: str | P
                             record_dt=h, hold=h)
         runs[f] = r
         i1 = min(int(round(1.0 / h)) - 1, len(r.t) - 1)
+        growth = force_growth(r)
         summary[f] = {
-            "diverged": bool(len(r.status) > len(r.t) and r.status[-1] == 1),
+            "diverged": bool((len(r.status) > len(r.t) and r.status[-1] == 1) or (growth or 0.0) > 10.0),
+            "force_oscillation_growth_after_ramp": growth,
             "t_reached_s": float(r.t[-1]) if len(r.t) else 0.0,
             "blades_in_contact_at_1s": int((r.F_N[i1] > 0).sum()) if len(r.t) else 0,
             "max_normal_force_N": float(r.F_N.max()) if r.F_N.size else 0.0,
@@ -263,7 +277,7 @@ def transient_pair(fmu: str | Path, model, speed: float, g0: float, out: str | P
             "max_rel_diff_F_N_vs_library": _rel_diff(r.F_N, lib.outputs["F_N"]),
         }
     _plot_forces(runs, out / "fmu_contact_forces.png", f"normal contact forces through the FMU, "
-                 f"Ω = {speed:.3g} Ω_ref, g0 = {g0 * 1e3:.3g} mm")
+                 f"Ω = {speed:.3g} Ω_ref, g0 = {g0 * 1e3:.3g} mm", {f: summary[f]["diverged"] for f in runs})
     np.savez_compressed(out / "fmu_transients.npz", **{f"{f}_{k}": getattr(r, k) for f, r in runs.items()
                                                         for k in ("t", "F_N", "fraction", "friction_torque")})
     (out / "summary.json").write_text(json.dumps(summary, indent=1))
