@@ -49,18 +49,18 @@ import hashlib
 import io
 import json
 import math
-import shutil
 import sys
 import tempfile
 import time
 import zipfile
-from ctypes import byref
 from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
 import numpy as np
+
+from .fmi_run import FMUError, Slave
 
 HERE = Path(__file__).resolve().parent
 SPOOL_SCRIPT = HERE / "spool_slave.py"
@@ -476,119 +476,31 @@ def _trapezoid(y: np.ndarray, x: np.ndarray) -> float:
     return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(x)))
 
 
-class _Log:
-    """fmi2CallbackLogger collecting (status, message)."""
-
-    def __init__(self):
-        self.records: list[tuple[int, str]] = []
-
-    def __call__(self, _env, _instance, status, _category, message) -> None:
-        text = message.decode("utf-8", "replace") if isinstance(message, bytes) else str(message)
-        self.records.append((int(status), text))
-
-    def problems(self, since: int = 0, level: int = 1) -> list[str]:
-        return [m for s, m in self.records[since:] if s >= level]
-
-
-class FmuInstance:
-    """One co-simulation instance through fmpy's FMU2Slave, logging on, variables addressed by name.
-
-    pythonfmu forwards the slave's log messages only when the instance is created with
-    loggingOn = true; they are kept in ``log.records`` as (status, message). ``fmu`` is
-    the fmpy FMU2Slave (its calls raise FMICallException on fmi2Discard and worse).
-    """
+class FmuInstance(Slave):
+    """A :class:`~fmu_src.fmi_run.Slave` created uninitialised (logging on, variables by name);
+    :meth:`initialize` raises :class:`EngineError` when the FMU logs an fmi2Error while
+    initializing (pythonfmu reports a refused configuration that way, with fmi2OK)."""
 
     def __init__(self, fmu: str | Path, instance_name: str):
-        from fmpy import extract, read_model_description
-        from fmpy.fmi2 import (
-            FMU2Slave,
-            fmi2CallbackAllocateMemoryTYPE,
-            fmi2CallbackFreeMemoryTYPE,
-            fmi2CallbackFunctions,
-            fmi2CallbackLoggerTYPE,
-        )
-
-        fmu = Path(fmu)
-        self._tmp = None
-        if fmu.is_dir():
-            unzip = str(fmu)
-        else:
-            unzip = extract(str(fmu))
-            self._tmp = unzip
-        self.md = read_model_description(unzip)
-        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
-        self.var = {v.name: v for v in self.md.modelVariables}
-        self.log = _Log()
-        from fmpy import calloc, free
-
-        cb = fmi2CallbackFunctions()
-        cb.logger = fmi2CallbackLoggerTYPE(self.log)
-        cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-        cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
         try:
-            from fmpy.logging import addLoggerProxy
+            super().__init__(fmu, instance_name, initialize=False)
+        except FMUError as exc:
+            raise EngineError(f"{instance_name}: {fmu} could not be instantiated ({exc})", exc.messages) from exc
 
-            addLoggerProxy(byref(cb))
-        except Exception:  # noqa: BLE001 - messages without printf formatting still arrive
-            pass
-        self._cb = cb
-        self.name = instance_name
-        self._alive = False
-        try:
-            self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=unzip,
-                                 modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=instance_name)
-            self.fmu.instantiate(callbacks=cb, loggingOn=True)
-        except Exception as exc:
-            self.close()
-            raise EngineError(f"{instance_name}: {fmu} could not be instantiated ({exc})",
-                              self.log.problems()) from exc
-        self._alive = True
+    def _vr(self, name: str):
+        if name not in self.variables:
+            raise EngineError(f"{self.instance_name}: no variable '{name}'")
+        return self.variables[name]
 
-    def set(self, **values) -> None:
-        for k, v in values.items():
-            if k not in self.vr:
-                raise EngineError(f"{self.name}: no variable '{k}'")
-            typ = self.var[k].type
-            if typ == "String":
-                self.fmu.setString([self.vr[k]], [str(v)])
-            elif typ in ("Integer", "Enumeration"):
-                self.fmu.setInteger([self.vr[k]], [int(v)])
-            elif typ == "Boolean":
-                self.fmu.setBoolean([self.vr[k]], [bool(v)])
-            else:
-                self.fmu.setReal([self.vr[k]], [float(v)])
+    def vr(self, name: str) -> int:
+        return self._vr(name).valueReference
 
-    def get(self, name: str):
-        typ = self.var[name].type
-        if typ == "Real":
-            return self.fmu.getReal([self.vr[name]])[0]
-        if typ in ("Integer", "Enumeration"):
-            return self.fmu.getInteger([self.vr[name]])[0]
-        if typ == "String":
-            return self.fmu.getString([self.vr[name]])[0].decode()
-        return self.fmu.getBoolean([self.vr[name]])[0]
-
-    def initialize(self, t0: float, t_end: float, **start) -> None:
+    def initialize(self, t0: float = 0.0, t_end: float | None = None, **start) -> None:
         n0 = len(self.log.records)
-        self.fmu.setupExperiment(startTime=t0, stopTime=t_end)
-        self.fmu.enterInitializationMode()
-        self.set(**start)
-        self.fmu.exitInitializationMode()
-        errs = self.log.problems(n0, level=3)  # fmi2Error: a configuration the FMU refuses
+        super().initialize(t0, t_end, **start)
+        errs = self.log.problems(n0, level=3)
         if errs:
-            raise EngineError(f"{self.name}: initialization refused", errs)
-
-    def close(self) -> None:
-        if self._alive:
-            self._alive = False
-            try:
-                self.fmu.terminate()
-            except Exception:  # noqa: BLE001 - terminating after a failure may itself fail
-                pass
-            self.fmu.freeInstance()
-        if self._tmp:
-            shutil.rmtree(self._tmp, ignore_errors=True)
-            self._tmp = None
+            raise EngineError(f"{self.instance_name}: initialization refused", errs)
 
 
 @dataclass
@@ -796,21 +708,21 @@ def run_coupled(contact_fmu: str | Path, spool_fmu: str | Path, t_end: float, h:
                   "Omega": omega0, **(contact_params or {})}
         contact.initialize(t_start, t_end, **cstart)
         J = spool.get("J")
-        nb = sum(1 for name in contact.vr if name.startswith("blade[") and name.endswith("].F_N"))
+        nb = sum(1 for name in contact.variables if name.startswith("blade[") and name.endswith("].F_N"))
 
         def arr(ctype, values):
             return (ctype * len(values))(*values)
 
         s_out_names = ["Omega", "Omega_schedule", "drive_torque", "windage_torque"]
         c_out_names = ["friction_torque", "gap_min"] + [f"blade[{j}].F_N" for j in range(1, nb + 1)]
-        s_vr_out = arr(fmi2ValueReference, [spool.vr[k] for k in s_out_names])
-        c_vr_out = arr(fmi2ValueReference, [contact.vr[k] for k in c_out_names])
-        s_vr_int = arr(fmi2ValueReference, [spool.vr["status"]])
-        c_vr_int = arr(fmi2ValueReference, [contact.vr["n_contact"], contact.vr["status"]])
+        s_vr_out = arr(fmi2ValueReference, [spool.vr(k) for k in s_out_names])
+        c_vr_out = arr(fmi2ValueReference, [contact.vr(k) for k in c_out_names])
+        s_vr_int = arr(fmi2ValueReference, [spool.vr("status")])
+        c_vr_int = arr(fmi2ValueReference, [contact.vr("n_contact"), contact.vr("status")])
         s_vals, c_vals = (fmi2Real * len(s_out_names))(), (fmi2Real * len(c_out_names))()
         s_ints, c_ints = (fmi2Integer * 1)(), (fmi2Integer * 2)()
-        c_vr_in = arr(fmi2ValueReference, [contact.vr["Omega"], contact.vr["imbalance"]])
-        s_vr_in = arr(fmi2ValueReference, [spool.vr["friction_torque"]])
+        c_vr_in = arr(fmi2ValueReference, [contact.vr("Omega"), contact.vr("imbalance")])
+        s_vr_in = arr(fmi2ValueReference, [spool.vr("friction_torque")])
         c_in, s_in = (fmi2Real * 2)(), (fmi2Real * 1)()
         sf, cf = spool.fmu, contact.fmu
         sc, cc = sf.component, cf.component

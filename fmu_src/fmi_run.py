@@ -53,8 +53,9 @@ class _Log:
         if self.echo:
             print(text)
 
-    def problems(self, since: int = 0) -> list[str]:
-        return [m for s, m in self.records[since:] if s >= 1]
+    def problems(self, since: int = 0, level: int = 1) -> list[str]:
+        """Messages logged since record ``since`` with status >= ``level`` (1 warning, 2 discard, 3 error)."""
+        return [m for s, m in self.records[since:] if s >= level]
 
 
 def simulate(fmu: str | Path, **kwargs) -> np.ndarray:
@@ -77,12 +78,14 @@ def simulate(fmu: str | Path, **kwargs) -> np.ndarray:
 class Slave:
     """One co-simulation instance through fmpy's FMU2Slave, addressed by variable name.
 
-    ``start`` values are set before initialization (parameters, initial inputs).
-    ``unzip_dir``: an already extracted FMU (several instances can share it).
+    ``fmu``: a .fmu file or an extracted folder. ``unzip_dir``: where the .fmu is already
+    extracted (several instances can share it). ``start`` values are set before
+    initialization (parameters, initial inputs); with ``initialize=False`` the instance is
+    only instantiated and :meth:`initialize` is the caller's.
     """
 
     def __init__(self, fmu: str | Path, instance_name: str = "instance", unzip_dir: str | Path | None = None,
-                 start_time: float = 0.0, echo_log: bool = False, **start):
+                 start_time: float = 0.0, echo_log: bool = False, initialize: bool = True, **start):
         from fmpy import extract, read_model_description
         from fmpy.fmi2 import (
             FMU2Slave,
@@ -94,8 +97,11 @@ class Slave:
             free,
         )
 
+        if unzip_dir is None and Path(fmu).is_dir():
+            unzip_dir = fmu
         self._own_dir = unzip_dir is None
         self.unzip_dir = str(Path(extract(str(fmu)) if unzip_dir is None else unzip_dir).resolve())
+        self.instance_name = instance_name
         md = read_model_description(self.unzip_dir)
         self.model_description = md
         self.variables = {v.name: v for v in md.modelVariables}
@@ -110,14 +116,20 @@ class Slave:
         self._alive = False
         self._call("fmi2Instantiate", self.fmu.instantiate, callbacks=cb, loggingOn=True)
         self._alive = True
-        try:
-            self._call("fmi2SetupExperiment", self.fmu.setupExperiment, startTime=start_time)
-            self._call("fmi2EnterInitializationMode", self.fmu.enterInitializationMode)
-            self.set(**start)
-            self._call("fmi2ExitInitializationMode", self.fmu.exitInitializationMode)
-        except BaseException:
-            self.close()
-            raise
+        self.time = start_time
+        if initialize:
+            try:
+                self.initialize(start_time, **start)
+            except BaseException:
+                self.close()
+                raise
+
+    def initialize(self, start_time: float = 0.0, stop_time: float | None = None, **start) -> None:
+        """fmi2SetupExperiment, fmi2EnterInitializationMode, the ``start`` values, fmi2ExitInitializationMode."""
+        self._call("fmi2SetupExperiment", self.fmu.setupExperiment, startTime=start_time, stopTime=stop_time)
+        self._call("fmi2EnterInitializationMode", self.fmu.enterInitializationMode)
+        self.set(**start)
+        self._call("fmi2ExitInitializationMode", self.fmu.exitInitializationMode)
         self.time = start_time
 
     # -- plumbing
@@ -139,14 +151,14 @@ class Slave:
         """Set variables by name (Real, Integer, Boolean, String by their declared type)."""
         for name, value in values.items():
             v = self._vr(name)
-            fn = {"Real": self.fmu.setReal, "Integer": self.fmu.setInteger, "Boolean": self.fmu.setBoolean,
-                  "String": self.fmu.setString}[v.type]
+            fn = {"Real": self.fmu.setReal, "Integer": self.fmu.setInteger, "Enumeration": self.fmu.setInteger,
+                  "Boolean": self.fmu.setBoolean, "String": self.fmu.setString}[v.type]
             self._call(f"set {name}", fn, [v.valueReference], [value])
 
     def get(self, name: str):
         v = self._vr(name)
-        fn = {"Real": self.fmu.getReal, "Integer": self.fmu.getInteger, "Boolean": self.fmu.getBoolean,
-              "String": self.fmu.getString}[v.type]
+        fn = {"Real": self.fmu.getReal, "Integer": self.fmu.getInteger, "Enumeration": self.fmu.getInteger,
+              "Boolean": self.fmu.getBoolean, "String": self.fmu.getString}[v.type]
         out = self._call(f"get {name}", fn, [v.valueReference])[0]
         return out.decode() if isinstance(out, bytes) else out
 
