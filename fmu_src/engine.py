@@ -60,6 +60,8 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
+from rotorub_model.results import pyplot, save_figure, write_json
+
 from .fmi_run import FMUError, Slave
 
 HERE = Path(__file__).resolve().parent
@@ -623,11 +625,7 @@ class CoupledResult:
 
     def plot(self, path: str | Path, reference: CoupledResult | None = None) -> Path:
         """PNG: spin speed (with the rub-free run), speed shortfall, friction torque, contact forces."""
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
+        plt = pyplot()
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         fig, ax = plt.subplots(4, 1, figsize=(9, 11), sharex=True)
@@ -660,10 +658,7 @@ class CoupledResult:
         ax[3].set_xlabel("time [s]")
         for a in ax:
             a.grid(alpha=0.3)
-        fig.tight_layout()
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
-        return path
+        return save_figure(fig, path, dpi=110)
 
 
 def run_coupled(contact_fmu: str | Path, spool_fmu: str | Path, t_end: float, h: float = 1e-3,
@@ -844,7 +839,7 @@ def run_coupled_scenario(out_dir: str | Path, quick: bool = True, contact_fmu: s
                     "no_rub_wall_time_s": ref.meta["wall_time_s"], "build_time_s": build_s, "ssp": str(ssp),
                     "ssp_valid": True, "contact_fmu": str(contact_fmu), "spool_fmu": str(spool_fmu),
                     "quick": quick})
-    (out / "summary.json").write_text(json.dumps(summary, indent=1))
+    write_json(out / "summary.json", summary)
     summary["figures"] = [("Coupled run-up: spool speed with and without rub, friction torque, contact forces",
                            "coupled_runup.png")]
     return summary

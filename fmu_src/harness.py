@@ -19,12 +19,13 @@ two may land on different ones, and the comparison counts those cells.
 
 from __future__ import annotations
 
-import json
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from rotorub_model.results import pyplot, save_figure, write_json
 
 from .fmi_run import Slave
 
@@ -70,7 +71,6 @@ class QuasiStaticMaps:
         return out
 
     def plot(self, path: str | Path) -> Path:
-        from rotorub_model.results import pyplot
 
         plt = pyplot()
         fig, axes = plt.subplots(1, len(self.n_contact), figsize=(11, 4.2), sharey=True)
@@ -83,10 +83,7 @@ class QuasiStaticMaps:
             ax.set_xlabel("Ω / Ω_ref")
             fig.colorbar(pc, ax=ax, label="blades in contact")
         np.atleast_1d(axes)[0].set_ylabel("g0 [mm]")
-        fig.tight_layout()
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-        return Path(path)
+        return save_figure(fig, path)
 
 
 def quasi_static_maps(fmu: str | Path, model, speeds: np.ndarray, g0s: np.ndarray, workdir: str | Path,
@@ -220,7 +217,6 @@ def _rel_diff(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def _plot_forces(runs: dict[str, FMURun], path: Path, title: str, diverged: dict[str, bool]) -> Path:
-    from rotorub_model.results import pyplot
 
     plt = pyplot()
     fig, axes = plt.subplots(len(runs), 1, figsize=(8, 3 * len(runs)), sharex=True, squeeze=False)
@@ -234,10 +230,7 @@ def _plot_forces(runs: dict[str, FMURun], path: Path, title: str, diverged: dict
         if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=7, ncol=3)
     axes[-1, 0].set_xlabel("time [s]")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def transient_pair(fmu: str | Path, model, speed: float, g0: float, out: str | Path, t_end: float = 20.0,
@@ -280,7 +273,7 @@ def transient_pair(fmu: str | Path, model, speed: float, g0: float, out: str | P
                  f"Ω = {speed:.3g} Ω_ref, g0 = {g0 * 1e3:.3g} mm", {f: summary[f]["diverged"] for f in runs})
     np.savez_compressed(out / "fmu_transients.npz", **{f"{f}_{k}": getattr(r, k) for f, r in runs.items()
                                                         for k in ("t", "F_N", "fraction", "friction_torque")})
-    (out / "summary.json").write_text(json.dumps(summary, indent=1))
+    write_json(out / "summary.json", summary)
     return summary
 
 
@@ -309,7 +302,6 @@ def run_up(fmu: str | Path, model, out: str | Path, speed_from: float = 2.6, spe
                           name="run_up", progress=progress)
     lib = run_transient(model, make_contact(model, formulation, g0=g0), omega_of_t, t_end=duration, t_ramp=0.0,
                         me=me, record_dt=h, hold=h)
-    from rotorub_model.results import pyplot
 
     plt = pyplot()
     fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
@@ -327,9 +319,7 @@ def run_up(fmu: str | Path, model, out: str | Path, speed_from: float = 2.6, spe
     axes[0].set_title(f"{formulation} run-up through the first critical speed through the FMU, g0 = {g0 * 1e3:g} mm")
     for ax in axes:
         ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(out / "run_up.png", dpi=120)
-    plt.close(fig)
+    save_figure(fig, out / "run_up.png")
     k_peak = int(np.argmax(np.hypot(*r.disk.T))) if len(r.t) else 0
     summary = {
         "formulation": formulation, "g0_mm": g0 * 1e3, "speed_from": speed_from, "speed_to": speed_to,
@@ -343,5 +333,5 @@ def run_up(fmu: str | Path, model, out: str | Path, speed_from: float = 2.6, spe
         "max_rel_diff_disk_vs_library": _rel_diff(r.disk, lib.outputs["disk_fixed"]),
     }
     np.savez_compressed(out / "run_up.npz", t=r.t, omega=r.omega, F_N=r.F_N, disk=r.disk)
-    (out / "summary.json").write_text(json.dumps(summary, indent=1))
+    write_json(out / "summary.json", summary)
     return summary

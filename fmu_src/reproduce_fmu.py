@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from rotorub_model.results import write_json
+
 
 def _step(msg: str) -> None:
     print(f"[reproduce] {msg}", flush=True)
@@ -38,7 +40,7 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
     qs = quasi_static_maps(fmu, model, speeds, g0s, out / "fmu_quasi_static", progress=progress)
     qs.plot(out / "fmu_quasi_static" / "fmu_maps.png")
     qsum = qs.summary()
-    (out / "fmu_quasi_static" / "summary.json").write_text(_json(qsum))
+    write_json(out / "fmu_quasi_static" / "summary.json", qsum)
 
     tr = summary["transient"]
     speed, g0 = float(tr["speed"]), float(tr["g0_mm"]) * 1e-3
@@ -78,9 +80,3 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
         *[(t, str(Path("coupled") / p)) for t, p in coupled.get("figures", [])],
     ]
     return res
-
-
-def _json(d: dict) -> str:
-    import json
-
-    return json.dumps(d, indent=1, default=float)

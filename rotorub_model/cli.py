@@ -116,7 +116,7 @@ def cmd_static(ns: argparse.Namespace) -> dict:
 
 
 def _plot_static(contact, st, path: Path, title: str) -> None:
-    from .results import pyplot
+    from .results import pyplot, save_figure
 
     plt = pyplot()
     g = contact.gaps(st.q) * 1e3
@@ -132,9 +132,7 @@ def _plot_static(contact, st, path: Path, title: str) -> None:
     axes[1].set_ylabel("gap [mm]")
     axes[1].legend()
     fig.suptitle(title + ("" if st.converged else " — NOT CONVERGED"))
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)
 
 
 def _sweep_args(fn):

@@ -47,7 +47,7 @@ from .contact import ContactModel, make_contact
 from .errors import ParameterError
 from .linear import _check_speed_range, run_response
 from .model import Model
-from .results import pyplot, write_json
+from .results import pyplot, save_figure, write_json
 
 THETAS_DEG = (0.0, 5.0, 10.0, 20.0, 30.0)
 CHORDS_M = (0.01, 0.05, 0.10, 0.20, 0.30)
@@ -292,10 +292,7 @@ class DetectionResult:
             ax.legend(loc="upper right", fontsize=8)
         else:
             raise ParameterError(f"study: '{study}' unknown; accepted: 2d_3d, variants, theta, chord")
-        fig.tight_layout()
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-        return Path(path)
+        return save_figure(fig, path)
 
     def save(self, out: str | Path) -> dict:
         """Write detection_{2d_3d,variants,theta,chord}.png, summary.json, detection.npz into ``out``."""

@@ -32,7 +32,7 @@ from scipy.signal import find_peaks
 
 from .errors import ParameterError
 from .model import Model
-from .results import pyplot, write_json
+from .results import pyplot, save_figure, write_json
 
 
 def linear_response(model: Model, omega: float, me: float | None = None) -> np.ndarray:
@@ -92,10 +92,7 @@ class ResponseResult:
         ax.set_ylabel("fan-disk displacement [mm]")
         ax.set_title("Imbalance response at the fan disk")
         ax.grid(True, which="both", alpha=0.3)
-        fig.tight_layout()
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-        return Path(path)
+        return save_figure(fig, path)
 
     def save(self, out: str | Path) -> dict:
         out = Path(out)
@@ -215,10 +212,7 @@ class ModesResult:
         ax.set_ylabel("rotating-frame frequency [Hz]")
         ax.set_title(f"Eigenvalues at Ω = {self.speed:.3g} (colour: |nodal diameter|)")
         ax.grid(alpha=0.3)
-        fig.tight_layout()
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-        return Path(path)
+        return save_figure(fig, path)
 
     def save(self, out: str | Path) -> dict:
         out = Path(out)
@@ -285,10 +279,7 @@ class CampbellResult:
             fig.colorbar(sc, ax=ax, label="|nodal diameter|")
         ax.legend(loc="upper left")
         ax.grid(alpha=0.3)
-        fig.tight_layout()
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-        return Path(path)
+        return save_figure(fig, path)
 
     def save(self, out: str | Path) -> dict:
         out = Path(out)

@@ -25,7 +25,7 @@ import numpy as np
 from .contact import make_contact
 from .model import Model, build_model
 from .params import from_dict, to_dict
-from .results import pyplot, write_json
+from .results import pyplot, save_figure, write_json
 from .stability import stability_of
 from .static import solve_static
 from .sweeps import run_tasks
@@ -158,10 +158,7 @@ class StabilityMap:
         axes[0].set_ylabel("initial clearance g0 [mm]")
         axes[0].set_title(f"{self.formulation}: contact configuration")
         axes[1].set_title(f"{self.formulation}: stability (green = stable, grey = no equilibrium)")
-        fig.tight_layout()
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-        return Path(path)
+        return save_figure(fig, path)
 
     def save(self, out: str | Path) -> dict:
         out = Path(out)

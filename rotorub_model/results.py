@@ -19,6 +19,14 @@ def pyplot():
     return plt
 
 
+def save_figure(fig, path: str | Path, dpi: int = 120) -> Path:
+    """Lay out, write the PNG and release the figure (figures are many in a sweep: never leak one)."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)
+    pyplot().close(fig)
+    return Path(path)
+
+
 def plain(x: Any) -> Any:
     if isinstance(x, dict):
         return {str(k): plain(v) for k, v in x.items()}

@@ -14,7 +14,7 @@ from .contact import make_contact
 from .errors import ParameterError
 from .maps import StabilityMap, run_stability_map
 from .model import Model
-from .results import pyplot, write_json
+from .results import pyplot, save_figure, write_json
 from .stability import stability_of
 from .static import solve_static
 from .transient import TransientResult, run_transient
@@ -90,9 +90,7 @@ def _plot_pair(maps: dict[str, StabilityMap], path: Path) -> None:
     axes[0, 1].set_title("stability: Σ positive real parts (green = stable contact, grey = no equilibrium)")
     for ax in axes[1]:
         ax.set_xlabel("normalised spin speed Ω / Ω_ref")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)
 
 
 def point_status(model: Model, speed: float, g0: float) -> dict:
@@ -235,10 +233,7 @@ class TransientStudy:
             ax.grid(alpha=0.3)
             ax.legend(fontsize=7)
         fig.suptitle(f"Ω = {self.speed:.3g}, g0 = {self.g0 * 1e3:.3g} mm (imbalance ramp over 1 s)")
-        fig.tight_layout()
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-        return Path(path)
+        return save_figure(fig, path)
 
     def save(self, out: str | Path) -> dict:
         out = Path(out)

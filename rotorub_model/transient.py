@@ -41,7 +41,7 @@ from .contact import ContactModel
 from .contact_law import blade_laws
 from .errors import ParameterError
 from .model import Model
-from .results import pyplot, write_json
+from .results import pyplot, save_figure, write_json
 
 
 @njit(cache=True)
@@ -340,10 +340,7 @@ class TransientResult:
         axes[1].set_xlabel("time [s]")
         for ax in axes:
             ax.grid(alpha=0.3)
-        fig.tight_layout()
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-        return Path(path)
+        return save_figure(fig, path)
 
     def save(self, out: str | Path, stem: str | None = None) -> dict:
         out = Path(out)
