@@ -405,9 +405,7 @@ class RotorCasingContact(Fmi2Slave):
         omega, me, g0 = self._r("Omega"), self._r("imbalance"), self._r("g0")
         if g0 != sim["g0"]:
             sim["g0"] = g0
-            sim["contact"] = sim["contact"].with_clearance(g0)
-            if "cd" in sim:
-                sim["cd"].set_clearance(g0)
+            self._apply_clearance(g0)
         if sim["config"]["mode"] == "transient":
             ok = self._transient(omega, me, h)
         else:
@@ -419,6 +417,16 @@ class RotorCasingContact(Fmi2Slave):
             self._iv[self._slot["status"]] = STATUS_OK
             self._sv[self._slot["message"]] = ""
         return ok
+
+    def _apply_clearance(self, g0: float) -> None:
+        """One contact model per clearance, shared by the integrator and the outputs."""
+        sim = self._sim
+        if "cd" in sim:
+            if sim["cd"].contact.g0 != g0:
+                sim["cd"].set_clearance(g0)
+            sim["contact"] = sim["cd"].contact
+        else:
+            sim["contact"] = sim["contact"].with_clearance(g0)
 
     def _stability_cap(self, omega: float) -> float:
         """Half the central-difference stability limit (the library's default step), evaluated at omega
@@ -541,15 +549,15 @@ class RotorCasingContact(Fmi2Slave):
             self._rv[:] = rv
             self._iv[:] = iv
         sim = self._sim
-        if s["g0"] != sim["g0"]:
-            sim["g0"] = s["g0"]
-            sim["contact"] = sim["contact"].with_clearance(s["g0"])
         sim["phi"] = float(s["phi"])
         sim["q_static"] = None if s["q_static"] is None else np.array(s["q_static"], dtype=float)
         if "cd" in s:
-            c = s["cd"]
+            c = s["cd"]  # set_state restores the integrator's clearance too
             sim["cd"].set_state((c["t"], c["steps"], c["phi"], np.asarray(c["q"], dtype=float),
                                  np.asarray(c["q_prev"], dtype=float), c["diverged"], c["dt"], c["g0"]))
+        if s["g0"] != sim["g0"]:
+            sim["g0"] = s["g0"]
+            self._apply_clearance(s["g0"])
 
     @staticmethod
     def _fmu_state_to_bytes(state) -> bytes:
