@@ -18,6 +18,15 @@ def ref_params():
 
 
 @pytest.fixture(scope="session")
+def contact_fmu(tmp_path_factory):
+    """RotorCasingContact.fmu built once from the working tree for every FMU test (read-only)."""
+    pytest.importorskip("pythonfmu", reason="building the FMU needs pythonfmu (pip install -e '.[fmu]')")
+    from fmu_src.build import build_fmu
+
+    return build_fmu(tmp_path_factory.mktemp("contact_fmu"))["fmu"]
+
+
+@pytest.fixture(scope="session")
 def ref_model(ref_params):
     """The 38-dof reference model; tests must not modify its arrays."""
     return build_model(ref_params)

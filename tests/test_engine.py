@@ -13,6 +13,7 @@ from __future__ import annotations
 import io
 import math
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -28,7 +29,6 @@ from fmu_src.engine import (  # noqa: E402
     CONNECTIONS,
     EngineError,
     FmuInstance,
-    build_contact_fmu,
     build_spool_fmu,
     run_coupled,
     scenario_settings,
@@ -74,9 +74,9 @@ def integrate_spool(t_eval, tau_ext, J=J_REF, cw=CW_REF):
 
 
 @pytest.fixture(scope="module")
-def fmus(tmp_path_factory):
+def fmus(tmp_path_factory, contact_fmu):
     d = tmp_path_factory.mktemp("engine_fmus")
-    return {"contact": build_contact_fmu(d), "spool": build_spool_fmu(d), "dir": d}
+    return {"contact": Path(contact_fmu), "spool": build_spool_fmu(d), "dir": d}
 
 
 @pytest.fixture(scope="module")

@@ -14,7 +14,6 @@ import pytest
 fmpy = pytest.importorskip("fmpy", reason="the FMU tests drive the FMU with fmpy (pip install -e '.[fmu]')")
 pytest.importorskip("pythonfmu", reason="building the FMU needs pythonfmu (pip install -e '.[fmu]')")
 
-from fmu_src.build import build_fmu  # noqa: E402
 from fmu_src.fmi_run import FMUError, Slave, simulate  # noqa: E402
 from rotorub_model.contact import make_contact  # noqa: E402
 from rotorub_model.stability import stability_of  # noqa: E402
@@ -28,10 +27,8 @@ FR = [f"blade[{j}].contact_fraction" for j in range(1, NB + 1)]
 
 
 @pytest.fixture(scope="module")
-def fmu(tmp_path_factory):
-    out = tmp_path_factory.mktemp("fmus")
-    info = build_fmu(out)
-    return info["fmu"]
+def fmu(contact_fmu):
+    return contact_fmu
 
 
 @pytest.fixture(scope="module")

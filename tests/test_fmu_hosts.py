@@ -14,7 +14,6 @@ fmi2Discard and a logged message naming Omega, and the native host must shut the
 
 from __future__ import annotations
 
-import importlib.util
 import os
 import shutil
 import subprocess
@@ -41,14 +40,9 @@ STATUS_BAD_INPUT = 2  # the FMU's `status` output
 
 # ---------------------------------------------------------------------------------------------- fixtures
 @pytest.fixture(scope="module")
-def fmu(tmp_path_factory) -> Path:
-    """A fresh build of the FMU from the working tree (fmu_src/build.py imported by path)."""
-    pytest.importorskip("pythonfmu", reason="building the FMU needs pythonfmu (the 'fmu' extra)")
-    spec = importlib.util.spec_from_file_location("_rotorub_fmu_build_for_hosts", ROOT / "fmu_src" / "build.py")
-    build = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(build)
-    out = build.build_fmu(tmp_path_factory.mktemp("fmu"))
-    return Path(out["fmu"])
+def fmu(contact_fmu) -> Path:
+    """The FMU built from the working tree (conftest)."""
+    return Path(contact_fmu)
 
 
 @pytest.fixture(scope="module")

@@ -11,12 +11,11 @@ pytest.importorskip("fmpy", reason="the harnesses drive the FMU with fmpy (pip i
 pytest.importorskip("pythonfmu", reason="building the FMU needs pythonfmu (pip install -e '.[fmu]')")
 
 from fmu_src import harness  # noqa: E402
-from fmu_src.build import build_fmu  # noqa: E402
 
 
 @pytest.fixture(scope="module")
-def fmu(tmp_path_factory):
-    return build_fmu(tmp_path_factory.mktemp("fmus"))["fmu"]
+def fmu(contact_fmu):
+    return contact_fmu
 
 
 def test_transient_pair_matches_library_and_saves_fig12(fmu, ref_model, tmp_path):
