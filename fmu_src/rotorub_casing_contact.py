@@ -561,6 +561,8 @@ class RotorCasingContact(Fmi2Slave):
 
     @staticmethod
     def _fmu_state_to_bytes(state) -> bytes:
+        # pythonfmu calls this without an instance, so the bundled library's results.plain
+        # is out of reach here; this is its NumPy-to-JSON conversion for the state's types
         def plain(x):
             if isinstance(x, np.ndarray):
                 return x.tolist()
