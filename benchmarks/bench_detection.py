@@ -3,7 +3,7 @@
     /work/venv/bin/python benchmarks/bench_detection.py
 
 * linear responses q(Omega) on 400 speeds (one batched solve), and the per-speed
-  loop over rotorub_model.linear.linear_response for comparison;
+  loop over rotorub_model.analyses.linear.linear_response for comparison;
 * one 400 x 400 (Omega, g0) boolean map for one formulation once q(Omega) is known:
   the closure c(Omega) = max_p -(G_p q) and the comparison g0 < c(Omega)
   (target < 1 s), with and without building the contact model;
@@ -18,10 +18,10 @@ import time
 
 import numpy as np
 
+from rotorub_model.analyses.detection import closure, contact_map, linear_responses, run_detection
+from rotorub_model.analyses.linear import linear_response
 from rotorub_model.contact import make_contact
-from rotorub_model.detection import closure, contact_map, linear_responses, run_detection
-from rotorub_model.linear import linear_response
-from rotorub_model.model import build_model
+from rotorub_model.structure.model import build_model
 
 
 def best_of(fn, repeat: int = 5) -> float:

@@ -55,10 +55,10 @@ def main(argv: list[str] | None = None) -> int:
     from fmpy import extract, read_model_description, simulate_fmu
     from fmpy.fmi2 import FMU2Slave, fmi2Real, fmi2ValueReference
 
+    from rotorub_model.analyses.transient import CentralDifference, outputs_from_q, run_transient
     from rotorub_model.contact import make_contact
-    from rotorub_model.model import build_model
-    from rotorub_model.params import reference_parameters
-    from rotorub_model.transient import CentralDifference, outputs_from_q, run_transient
+    from rotorub_model.structure.model import build_model
+    from rotorub_model.structure.params import reference_parameters
 
     fmu_path = Path(ns.fmu)
     if not fmu_path.exists():

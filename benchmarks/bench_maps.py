@@ -9,9 +9,9 @@ import os
 import sys
 import time
 
-from rotorub_model.maps import run_stability_map
-from rotorub_model.model import build_model
-from rotorub_model.studies import default_grid
+from rotorub_model.analyses.maps import run_stability_map
+from rotorub_model.app.studies import default_grid
+from rotorub_model.structure.model import build_model
 
 
 def main(n: int = 100) -> None:

@@ -10,9 +10,9 @@ import time
 
 import numpy as np
 
+from rotorub_model.analyses.transient import CentralDifference, _linear_cd
 from rotorub_model.contact import make_contact
-from rotorub_model.model import build_model
-from rotorub_model.transient import CentralDifference, _linear_cd
+from rotorub_model.structure.model import build_model
 
 
 def best_of(fn, repeat=5):

@@ -64,8 +64,7 @@ def _check_relative_only(path: Path, text: str) -> str:
         if absolute_from and (node.module or "").split(".")[0] == "rotorub_model":
             raise BuildError(f"{path}:{node.lineno}: absolute import of rotorub_model; the FMU's copy needs "
                              "relative imports")
-    # resources.files("rotorub_model") (the embedded reference) -> the copy's own package
-    return text.replace('resources.files("rotorub_model")', "resources.files(__package__)")
+    return text
 
 
 def _documentation(doc: Path, manifest: dict, variables: list[tuple]) -> None:
@@ -136,7 +135,7 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None) 
     except ImportError:
         raise BuildError("pythonfmu is not installed: pip install 'rotorub[fmu]'") from None
     from rotorub_model import __version__ as lib_version
-    from rotorub_model.params import load_parameters
+    from rotorub_model.structure.params import load_parameters
 
     params_path = Path(params_file) if params_file else LIB / "data" / "reference.toml"
     params = load_parameters(params_path)  # validated now, not in the master

@@ -11,7 +11,7 @@ The FMU is driven through :class:`fmu_src.fmi_run.Slave`; the library side of ev
 comparison is the library's own analysis of the same case. A master holds inputs over
 each communication step, so the library transients are run with ``hold=h`` (the same
 zero-order hold): both sides then do the same arithmetic and differ by round-off.
-The quasi-static maps are compared with :func:`rotorub_model.maps.run_stability_map`,
+The quasi-static maps are compared with :func:`rotorub_model.analyses.maps.run_stability_map`,
 which solves each cell independently (from the linear response and a few restarts)
 instead of continuing along the sweep: where several balanced solutions coexist the
 two may land on different ones, and the comparison counts those cells.
@@ -123,7 +123,7 @@ def quasi_static_maps(fmu: str | Path, model, speeds: np.ndarray, g0s: np.ndarra
 
 
 def _compare_maps(model, res: QuasiStaticMaps) -> dict:
-    from rotorub_model.maps import run_stability_map
+    from rotorub_model.analyses.maps import run_stability_map
 
     out = {}
     for f in res.n_contact:
@@ -236,8 +236,8 @@ def _plot_forces(runs: dict[str, FMURun], path: Path, title: str, diverged: dict
 def transient_pair(fmu: str | Path, model, speed: float, g0: float, out: str | Path, t_end: float = 20.0,
                    t_ramp: float = 1.0, h: float = H_TRANSIENT, progress: bool = False) -> dict:
     """Section 6 through the FMU: 2D and 3D at (speed, g0), imbalance ramped over t_ramp by the master."""
+    from rotorub_model.analyses.transient import run_transient
     from rotorub_model.contact import make_contact
-    from rotorub_model.transient import run_transient
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -286,8 +286,8 @@ def run_up(fmu: str | Path, model, out: str | Path, speed_from: float = 2.6, spe
     Euler (angular-acceleration) terms are left out on both sides: the FMU has only Omega
     as input (their relative size here is dOmega/dt / Omega^2 < 1e-3).
     """
+    from rotorub_model.analyses.transient import run_transient
     from rotorub_model.contact import make_contact
-    from rotorub_model.transient import run_transient
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

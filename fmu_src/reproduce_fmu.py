@@ -1,7 +1,7 @@
 """The FMU half of ``rotorub reproduce``: build the FMUs, run the harnesses and the coupled
 engine scenario, and add their results to the library's summary and report.
 
-Called by :func:`rotorub_model.cli.cmd_reproduce` after the library analyses (whose
+Called by :func:`rotorub_model.app.cli.cmd_reproduce` after the library analyses (whose
 summary gives the transient point and the stability grid to compare with).
 """
 

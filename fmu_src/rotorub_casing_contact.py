@@ -54,8 +54,10 @@ UNITS = {
 
 # submodules of the bundled library imported eagerly: a later lazy import must not
 # depend on the folder it came from still existing (masters delete extracted FMUs)
-_LIB_MODULES = ("errors", "params", "frames", "ritz", "shaft", "blades", "casing", "model", "contact_law",
-                "contact2d", "contact3d", "contact", "results", "linear", "transient", "static", "stability")
+_LIB_MODULES = ("errors", "results", "structure.params", "structure.frames", "structure.ritz", "structure.shaft",
+                "structure.blades", "structure.casing", "structure.model", "contact.laws", "contact.geometry",
+                "contact.point2d", "contact.chord3d", "contact.contact_model", "contact", "analyses.linear",
+                "analyses.transient", "analyses.static", "analyses.stability")
 
 
 def _load_library(resources: Path) -> tuple[dict, object]:
@@ -70,7 +72,7 @@ def _load_library(resources: Path) -> tuple[dict, object]:
 
     lib = Lib()
     for name in _LIB_MODULES:
-        setattr(lib, name, importlib.import_module(f"{pkg}.{name}"))
+        setattr(lib, name.rpartition(".")[2], importlib.import_module(f"{pkg}.{name}"))
     return manifest, lib
 
 

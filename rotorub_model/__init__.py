@@ -7,8 +7,8 @@ analyses. SI units throughout; see docs/THEORY.md for the conventions.
 """
 
 from .errors import ConvergenceError, DivergenceError, ParameterError, RotorubError
-from .model import Model, build_model
-from .params import Parameters, load_parameters, reference_parameters
+from .structure.model import Model, build_model
+from .structure.params import Parameters, load_parameters, reference_parameters
 
 __all__ = [
     "ConvergenceError",

@@ -7,8 +7,8 @@ import math
 
 import pytest
 
-from rotorub_model.model import build_model
-from rotorub_model.params import reference_parameters
+from rotorub_model.structure.model import build_model
+from rotorub_model.structure.params import reference_parameters
 
 
 @pytest.fixture(scope="session")
@@ -51,7 +51,7 @@ def _toml_value(v) -> str:
 
 
 def to_toml(data: dict) -> str:
-    """A tiny TOML writer for the nested dicts of ``rotorub_model.params.to_dict``."""
+    """A tiny TOML writer for the nested dicts of ``rotorub_model.structure.params.to_dict``."""
     lines: list[str] = []
     for sec, val in data.items():
         for table in val if isinstance(val, list) else [val]:

@@ -9,10 +9,10 @@ import sys
 import numpy as np
 import pytest
 
-from rotorub_model.cli import main
-from rotorub_model.linear import run_response
-from rotorub_model.model import build_model
-from rotorub_model.params import reference_parameters, to_dict
+from rotorub_model.analyses.linear import run_response
+from rotorub_model.app.cli import main
+from rotorub_model.structure.model import build_model
+from rotorub_model.structure.params import reference_parameters, to_dict
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 N_SPEEDS = "300"
@@ -26,7 +26,7 @@ def _png_ok(path) -> None:
 
 def _cli(*args: str) -> subprocess.CompletedProcess:
     return subprocess.run(
-        [sys.executable, "-m", "rotorub_model.cli", *args], capture_output=True, text=True, timeout=120
+        [sys.executable, "-m", "rotorub_model.app.cli", *args], capture_output=True, text=True, timeout=120
     )
 
 

@@ -6,12 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from rotorub_model.analyses.linear import linear_response, run_response
 from rotorub_model.contact import ContactModel, make_contact
-from rotorub_model.contact_law import chord_law
+from rotorub_model.contact.laws import chord_law
 from rotorub_model.errors import ParameterError
-from rotorub_model.linear import linear_response, run_response
-from rotorub_model.model import build_model
-from rotorub_model.params import reference_parameters
+from rotorub_model.structure.model import build_model
+from rotorub_model.structure.params import reference_parameters
 
 K_R = 1.0e7
 L_C = 0.2
@@ -235,7 +235,7 @@ def test_chord_law_continuous_across_fronts(fixed, moving):
 
 
 def test_point_law_and_fraction():
-    from rotorub_model.contact_law import point_law
+    from rotorub_model.contact.laws import point_law
 
     assert point_law(-2e-3, K_R) == (pytest.approx(2e-3 * K_R), -K_R)
     assert point_law(1e-3, K_R) == (0.0, 0.0)

@@ -8,9 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from rotorub_model.cli import main
-from rotorub_model.contact import make_contact
-from rotorub_model.detection import (
+from rotorub_model.analyses.detection import (
     closure,
     contact_map,
     linear_responses,
@@ -18,9 +16,11 @@ from rotorub_model.detection import (
     run_detection,
     speed_grid,
 )
+from rotorub_model.analyses.linear import linear_response
+from rotorub_model.app.cli import main
+from rotorub_model.contact import make_contact
 from rotorub_model.errors import ParameterError
-from rotorub_model.linear import linear_response
-from rotorub_model.model import build_model
+from rotorub_model.structure.model import build_model
 
 
 @pytest.fixture(scope="module")

@@ -6,20 +6,20 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rotorub_model.contact import make_contact
-from rotorub_model.errors import ParameterError
-from rotorub_model.linear import linear_response
-from rotorub_model.model import build_model
-from rotorub_model.params import reference_parameters
-from rotorub_model.stability import stability_of
-from rotorub_model.static import solve_static
-from rotorub_model.transient import (
+from rotorub_model.analyses.linear import linear_response
+from rotorub_model.analyses.stability import stability_of
+from rotorub_model.analyses.static import solve_static
+from rotorub_model.analyses.transient import (
     CentralDifference,
     _linear_cd,
     all_closed_stiffness,
     critical_time_step,
     run_transient,
 )
+from rotorub_model.contact import make_contact
+from rotorub_model.errors import ParameterError
+from rotorub_model.structure.model import build_model
+from rotorub_model.structure.params import reference_parameters
 
 
 @pytest.fixture(scope="module")
@@ -64,7 +64,7 @@ def test_static_residual_is_honest(model):
 
 def _modal_amplitude(model, omega, K_extra, lam, q, v):
     """Projection of the state (q, v) on the eigenvector of lam (left eigenvector)."""
-    from rotorub_model.linear import first_order
+    from rotorub_model.analyses.linear import first_order
 
     A = first_order(model, omega, K_extra)
     w, vl = np.linalg.eig(A.T)
@@ -91,7 +91,7 @@ def _unstable_2d_point(model):
 
 def test_unstable_2d_transient_grows_at_eigenvalue_rate(model):
     omega, c, st, sb = _unstable_2d_point(model)
-    from rotorub_model.linear import first_order
+    from rotorub_model.analyses.linear import first_order
 
     Kx = c.jacobian(st.q)
     lam_all, vec = np.linalg.eig(first_order(model, omega, Kx))

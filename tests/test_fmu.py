@@ -15,10 +15,10 @@ fmpy = pytest.importorskip("fmpy", reason="the FMU tests drive the FMU with fmpy
 pytest.importorskip("pythonfmu", reason="building the FMU needs pythonfmu (pip install -e '.[fmu]')")
 
 from fmu_src.fmi_run import FMUError, Slave, simulate  # noqa: E402
+from rotorub_model.analyses.stability import stability_of  # noqa: E402
+from rotorub_model.analyses.static import solve_static  # noqa: E402
+from rotorub_model.analyses.transient import run_transient  # noqa: E402
 from rotorub_model.contact import make_contact  # noqa: E402
-from rotorub_model.stability import stability_of  # noqa: E402
-from rotorub_model.static import solve_static  # noqa: E402
-from rotorub_model.transient import run_transient  # noqa: E402
 
 NB = 10
 FN = [f"blade[{j}].F_N" for j in range(1, NB + 1)]

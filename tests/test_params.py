@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from rotorub_model.errors import ParameterError
-from rotorub_model.params import Parameters, load_parameters, reference_parameters, to_dict
+from rotorub_model.structure.params import Parameters, load_parameters, reference_parameters, to_dict
 
 
 def load_error(write_params, data: dict) -> str:

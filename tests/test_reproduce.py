@@ -7,8 +7,8 @@ import re
 
 import pytest
 
-from rotorub_model.model import build_model
-from rotorub_model.reproduce import run_reproduce
+from rotorub_model.app.reproduce import run_reproduce
+from rotorub_model.structure.model import build_model
 
 
 @pytest.fixture(scope="module")

@@ -19,13 +19,13 @@ from scipy.linalg import eigh
 from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
-from rotorub_model.blades import bladed_disk_matrices
-from rotorub_model.casing import casing_matrices, ring_modal, ring_radius
-from rotorub_model.linear import linear_response, run_modes, run_response
-from rotorub_model.model import build_model
-from rotorub_model.params import reference_parameters
-from rotorub_model.ritz import gauss
-from rotorub_model.shaft import shaft_functions
+from rotorub_model.analyses.linear import linear_response, run_modes, run_response
+from rotorub_model.structure.blades import bladed_disk_matrices
+from rotorub_model.structure.casing import casing_matrices, ring_modal, ring_radius
+from rotorub_model.structure.model import build_model
+from rotorub_model.structure.params import reference_parameters
+from rotorub_model.structure.ritz import gauss
+from rotorub_model.structure.shaft import shaft_functions
 
 # ---------------------------------------------------------------------------
 # helpers (independent references)

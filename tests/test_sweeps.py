@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rotorub_model.maps import run_stability_map
-from rotorub_model.model import build_model
+from rotorub_model.analyses.maps import run_stability_map
+from rotorub_model.structure.model import build_model
 
 SPEEDS = np.array([3.3, 3.4, 3.45])
 G0S = np.array([0.0, 0.6e-3, 1.2e-3])
@@ -45,7 +45,7 @@ def test_dask_cluster_matches_serial(model, serial):
 
 
 def test_interrupted_sweep_resumes(model, serial, tmp_path, monkeypatch):
-    import rotorub_model.maps as maps
+    import rotorub_model.analyses.maps as maps
 
     calls = []
     real = maps.map_row

@@ -52,12 +52,12 @@ def _transient_arrays(prefix: str, r) -> dict[str, np.ndarray]:
 
 def compute() -> dict[str, np.ndarray]:
     """Every golden array, computed with the installed library."""
+    from rotorub_model.analyses.detection import run_detection
+    from rotorub_model.analyses.stability import stability_of
+    from rotorub_model.analyses.static import solve_static
+    from rotorub_model.analyses.transient import run_transient
     from rotorub_model.contact import make_contact
-    from rotorub_model.detection import run_detection
-    from rotorub_model.model import build_model
-    from rotorub_model.stability import stability_of
-    from rotorub_model.static import solve_static
-    from rotorub_model.transient import run_transient
+    from rotorub_model.structure.model import build_model
 
     m = build_model()
     w_ref = m.params.normalisation.omega_ref

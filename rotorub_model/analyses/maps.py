@@ -22,10 +22,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .contact import make_contact
-from .model import Model, build_model
-from .params import from_dict, to_dict
-from .results import pyplot, save_figure, write_json
+from ..contact import make_contact
+from ..results import pyplot, save_figure, write_json
+from ..structure.model import Model, build_model
+from ..structure.params import from_dict, to_dict
 from .stability import stability_of
 from .static import solve_static
 from .sweeps import run_tasks

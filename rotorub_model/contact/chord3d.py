@@ -17,10 +17,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .blades import blade_angles, blade_frame, blade_tip_map, skew
-from .casing import casing_point_map
-from .contact import ContactGeometry
-from .model import Model
+from ..structure.blades import blade_angles, blade_frame, blade_tip_map, skew
+from ..structure.casing import casing_point_map
+from ..structure.model import Model
+from .geometry import ContactGeometry
 
 
 def geometry_3d(model: Model, theta: float, chord: float, rotations: bool = True) -> ContactGeometry:

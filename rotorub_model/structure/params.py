@@ -7,7 +7,7 @@ the accepted range, then checks the cross-field consistency rules.
 
 Examples
 --------
->>> from rotorub_model.params import reference_parameters
+>>> from rotorub_model.structure.params import reference_parameters
 >>> p = reference_parameters()
 >>> p.blades.count
 10
@@ -20,13 +20,15 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field, fields
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
 import tomllib
 
-from .errors import ParameterError
+from ..errors import ParameterError
+
+# next to the package, wherever it is installed or copied (the FMU carries a renamed copy)
+REFERENCE_FILE = Path(__file__).resolve().parents[1] / "data" / "reference.toml"
 
 INF = math.inf
 
@@ -327,7 +329,7 @@ def load_parameters(path: str | Path | None = None) -> Parameters:
         names the file and the offending field.
     """
     if path is None:
-        text = resources.files("rotorub_model").joinpath("data/reference.toml").read_text()
+        text = REFERENCE_FILE.read_text()
         where = "reference.toml"
     else:
         try:

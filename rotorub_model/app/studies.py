@@ -10,14 +10,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .contact import make_contact
-from .errors import ParameterError
-from .maps import StabilityMap, run_stability_map
-from .model import Model
-from .results import pyplot, save_figure, write_json
-from .stability import stability_of
-from .static import solve_static
-from .transient import TransientResult, run_transient
+from ..analyses.maps import StabilityMap, run_stability_map
+from ..analyses.stability import stability_of
+from ..analyses.static import solve_static
+from ..analyses.transient import TransientResult, run_transient
+from ..contact import make_contact
+from ..errors import ParameterError
+from ..results import pyplot, save_figure, write_json
+from ..structure.model import Model
 
 PAPER_POINT = (3.3, 0.8e-3)  # the paper's transient point (normalised speed, g0 [m])
 PAPER_PARTIAL = 0.88  # the paper's third blade touches over 88 % of its chord at that point
@@ -29,7 +29,7 @@ def default_grid(model: Model, quick: bool) -> tuple[np.ndarray, np.ndarray]:
     The quick grid spaces the clearances quadratically (denser near g0 = 0, where the
     contact region is thin away from the peak) so that its boundary is resolved.
     """
-    from .linear import run_response
+    from ..analyses.linear import run_response
 
     r = run_response(model, n_speeds=800)
     c1 = r.critical_speeds[0]
@@ -117,7 +117,7 @@ def pick_transient_point(model: Model, stab_dir: str | Path | None = None, quick
     if _qualifies(point_status(model, *PAPER_POINT)):
         return PAPER_POINT
     speed = PAPER_POINT[0]
-    from .linear import linear_response
+    from ..analyses.linear import linear_response
 
     q = linear_response(model, speed * model.params.normalisation.omega_ref)
     closure = float(-make_contact(model, "3D", g0=0.0).gaps(q).min())
@@ -147,7 +147,7 @@ def _pick_from_maps(model: Model, stab_dir: str | Path | None) -> tuple[float, f
         for f in ("2D", "3D"):
             m = run_stability_map(model, f, speeds, g0s, progress=False)
             maps[f] = {"speeds": m.speeds, "g0s": m.g0s, "n_contact": m.n_contact, "max_real": m.max_real}
-    from .stability import RE_TOL
+    from ..analyses.stability import RE_TOL
 
     m2, m3 = maps["2D"], maps["3D"]
     ok = (m2["n_contact"] > 0) & (m3["n_contact"] > 0) & (np.nan_to_num(m2["max_real"], nan=-1) > RE_TOL) & \

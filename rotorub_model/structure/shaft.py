@@ -1,7 +1,7 @@
 """Shaft (Euler–Bernoulli hollow beam), rigid disks and isotropic bearings.
 
 All three are axisymmetric, so they are built per transverse direction in the
-fixed frame and transformed with :func:`rotorub_model.frames.axisymmetric_to_rotating`.
+fixed frame and transformed with :func:`rotorub_model.structure.frames.axisymmetric_to_rotating`.
 Energies (per direction, Ritz u(z) = sum phi_i(z) a_i):
 
 * beam: T = 1/2 int rho A u'^2 + rho I u_z'^2 dz, V = 1/2 int E I (u'')^2 dz,

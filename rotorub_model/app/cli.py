@@ -13,8 +13,8 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from .errors import RotorubError
-from .params import load_parameters
+from ..errors import RotorubError
+from ..structure.params import load_parameters
 
 COMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], dict]]] = {}
 
@@ -40,7 +40,7 @@ def arg(*args, **kwargs):
 
 
 def _model(ns: argparse.Namespace):
-    from .model import build_model
+    from ..structure.model import build_model
 
     return build_model(load_parameters(ns.params))
 
@@ -50,7 +50,7 @@ def _model(ns: argparse.Namespace):
 @arg("--speed-max", type=float, default=10.0, help="highest normalised speed")
 @arg("--n-speeds", type=int, default=2000, help="number of speeds on the grid")
 def cmd_response(ns: argparse.Namespace) -> dict:
-    from .linear import run_response
+    from ..analyses.linear import run_response
 
     return run_response(_model(ns), ns.speed_min, ns.speed_max, ns.n_speeds).save(ns.out)
 
@@ -58,7 +58,7 @@ def cmd_response(ns: argparse.Namespace) -> dict:
 @command("modes", "eigenvalues at one speed, labelled in the fixed frame")
 @arg("--speed", type=float, default=3.5, help="normalised spin speed")
 def cmd_modes(ns: argparse.Namespace) -> dict:
-    from .linear import run_modes
+    from ..analyses.linear import run_modes
 
     return run_modes(_model(ns), ns.speed).save(ns.out)
 
@@ -67,7 +67,7 @@ def cmd_modes(ns: argparse.Namespace) -> dict:
 @arg("--speed-max", type=float, default=10.0, help="highest normalised speed")
 @arg("--n-speeds", type=int, default=60, help="number of speeds")
 def cmd_campbell(ns: argparse.Namespace) -> dict:
-    from .linear import run_campbell
+    from ..analyses.linear import run_campbell
 
     r = run_campbell(_model(ns), ns.speed_max, ns.n_speeds)
     r.save(ns.out)
@@ -81,7 +81,7 @@ def _executor(ns: argparse.Namespace):
         try:
             from dask.distributed import Client
         except ImportError:
-            from .errors import ParameterError
+            from ..errors import ParameterError
 
             raise ParameterError(
                 "--executor dask: dask.distributed is not installed (pip install 'rotorub[dask]')"
@@ -95,10 +95,10 @@ def _executor(ns: argparse.Namespace):
 @arg("--g0", type=float, default=0.8e-3, help="nominal clearance [m]")
 @arg("--formulation", default="3D", help="2D or 3D")
 def cmd_static(ns: argparse.Namespace) -> dict:
-    from .contact import make_contact
-    from .results import write_json
-    from .stability import stability_of
-    from .static import solve_static
+    from ..analyses.stability import stability_of
+    from ..analyses.static import solve_static
+    from ..contact import make_contact
+    from ..results import write_json
 
     m = _model(ns)
     c = make_contact(m, ns.formulation, g0=ns.g0)
@@ -116,7 +116,7 @@ def cmd_static(ns: argparse.Namespace) -> dict:
 
 
 def _plot_static(contact, st, path: Path, title: str) -> None:
-    from .results import pyplot, save_figure
+    from ..results import pyplot, save_figure
 
     plt = pyplot()
     g = contact.gaps(st.q) * 1e3
@@ -172,7 +172,7 @@ def cmd_transient(ns: argparse.Namespace) -> dict:
 @arg("--n-g0", type=int, default=400, help="clearances on the map's g0 axis")
 @arg("--g0-max-mm", type=float, default=None, help="top of the g0 axis [mm] (default: 1.05 x largest closure)")
 def cmd_detect(ns: argparse.Namespace) -> dict:
-    from .detection import run_detection
+    from ..analyses.detection import run_detection
 
     g0_max = None if ns.g0_max_mm is None else ns.g0_max_mm * 1e-3
     r = run_detection(_model(ns), speed_min=ns.speed_min, speed_max=ns.speed_max, n_speeds=ns.n_speeds,
@@ -194,7 +194,7 @@ def cmd_reproduce(ns: argparse.Namespace) -> dict:
     model = _model(ns)
     s = run_reproduce(model, ns.out, quick=ns.quick)
     if not ns.no_fmu:
-        from .errors import ParameterError
+        from ..errors import ParameterError
 
         try:
             from fmu_src.reproduce_fmu import run_fmu_part
@@ -202,8 +202,8 @@ def cmd_reproduce(ns: argparse.Namespace) -> dict:
             raise ParameterError(f"reproduce: the FMU part needs the fmu extra ({exc}); "
                                  "pip install -e '.[fmu]', or run with --no-fmu") from None
         s.update(run_fmu_part(model, ns.out, s, quick=ns.quick, fmu_dir=ns.fmu_dir, params_file=ns.params))
+        from ..results import write_json
         from .report import write_report
-        from .results import write_json
 
         write_json(Path(ns.out) / "summary.json", s)
         write_report(ns.out, s)
@@ -216,7 +216,7 @@ def cmd_reproduce(ns: argparse.Namespace) -> dict:
 def cmd_build_fmu(ns: argparse.Namespace) -> dict:
     """--params FILE becomes the FMU's default parameter file; --out is the folder of the .fmu
     (default for this command: fmus/). Needs the repository's fmu_src/ and pythonfmu."""
-    from .errors import ParameterError
+    from ..errors import ParameterError
 
     try:
         from fmu_src import build as mod
@@ -261,7 +261,7 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"rotorub {ns.command}: interrupted", file=sys.stderr)
         return 130
-    from .results import plain
+    from ..results import plain
 
     text = json.dumps(plain(result), indent=1) if isinstance(result, dict) else str(result)
     print(text if len(text) < 4000 else text[:4000] + "\n... (full result in --out)")

@@ -22,13 +22,13 @@ paper's Fig. 7: closure differences against speed); a sweep of the cone angle
 theta and one of the chord l_c (3D full, the other parameter at its default).
 
 Speed grid: a uniform grid plus the critical speeds of the imbalance response
-(:func:`rotorub_model.linear.run_response`, refined peaks) inserted exactly, plus a
+(:func:`rotorub_model.analyses.linear.run_response`, refined peaks) inserted exactly, plus a
 dense cluster of +-2 % around each critical, because the peaks are sharp (mode 1 is
 damped at about 1 %).
 
 Examples
 --------
->>> from rotorub_model.model import build_model
+>>> from rotorub_model.structure.model import build_model
 >>> r = run_detection(build_model(), n_speeds=100, n_g0=50, progress=False)
 >>> r.map("2D").shape[1]
 50
@@ -43,11 +43,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .contact import ContactModel, make_contact
-from .errors import ParameterError
+from ..contact import ContactModel, make_contact
+from ..errors import ParameterError
+from ..results import pyplot, save_figure, write_json
+from ..structure.model import Model
 from .linear import _check_speed_range, run_response
-from .model import Model
-from .results import pyplot, save_figure, write_json
 
 THETAS_DEG = (0.0, 5.0, 10.0, 20.0, 30.0)
 CHORDS_M = (0.01, 0.05, 0.10, 0.20, 0.30)
@@ -62,7 +62,7 @@ VARIANT_LABELS = {"kinematics_only": "3D kinematics only", "geometry_only": "3D 
 def linear_responses(model: Model, omegas: np.ndarray, me: float | None = None) -> np.ndarray:
     """q(Omega) of eq. (9) for every Omega [rad/s]: (n_speeds, n_dofs), one batched solve.
 
-    Same numbers as :func:`rotorub_model.linear.linear_response` at each speed.
+    Same numbers as :func:`rotorub_model.analyses.linear.linear_response` at each speed.
     """
     w = np.asarray(omegas, dtype=float)
     K = model.K[None] + (w * w)[:, None, None] * (model.S2 + model.N2)[None] + w[:, None, None] * model.C1[None]

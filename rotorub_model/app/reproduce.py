@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .model import Model
-from .results import write_json
+from ..results import write_json
+from ..structure.model import Model
 
 
 def fact1(resp: dict) -> dict:
@@ -71,14 +71,14 @@ def fact6(tr: dict) -> list[dict]:
 
 
 def run_reproduce(model: Model, out: str | Path, quick: bool = False) -> dict:
-    from .linear import run_campbell, run_modes, run_response
+    from ..analyses.linear import run_campbell, run_modes, run_response
 
     out = Path(out)
     resp = run_response(model, n_speeds=600 if quick else 2000).save(out / "response")
     run_modes(model, resp["critical_speeds"][0]).save(out / "modes")
     run_campbell(model, n_speeds=25 if quick else 80).save(out / "campbell")
-    from .detection import paper_facts as detection_facts
-    from .detection import run_detection
+    from ..analyses.detection import paper_facts as detection_facts
+    from ..analyses.detection import run_detection
 
     det = run_detection(model, n_speeds=200 if quick else 400).save(out / "detection")
     from .studies import run_stability_study, run_transient_study

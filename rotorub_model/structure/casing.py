@@ -12,7 +12,7 @@ displacement w(a) = -(1/n)(A_n sin(n a) - B_n cos(n a)) (so u + dw/da = 0):
 
 The casing does not spin, so in the rotating frame each (cos, sin) pair of harmonic n
 turns at -n Omega: Coriolis 2 n Omega M J, softening -n^2 Omega^2 M and circulation
-n Omega C J (see :mod:`rotorub_model.frames`).
+n Omega C J (see :mod:`rotorub_model.structure.frames`).
 
 Ring geometry: mid-surface radius R = blade tip radius + ring thickness / 2 (the
 nominal clearance, millimetres, is neglected in the ring's stiffness and mass).

@@ -37,11 +37,11 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from .contact import ContactModel
-from .contact_law import blade_laws
-from .errors import ParameterError
-from .model import Model
-from .results import pyplot, save_figure, write_json
+from ..contact import ContactModel
+from ..contact.laws import blade_laws
+from ..errors import ParameterError
+from ..results import pyplot, save_figure, write_json
+from ..structure.model import Model
 
 
 @njit(cache=True)

@@ -31,24 +31,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .contact_law import blade_laws
-from .errors import ParameterError
-from .model import Model
+from ..errors import ParameterError
+from ..structure.model import Model
+from .chord3d import geometry_3d
+from .geometry import ContactGeometry
+from .laws import blade_laws
+from .point2d import geometry_2d
 
 FORMULATIONS = ("2D", "3D")
 VARIANTS = ("full", "kinematics_only", "geometry_only")
-
-
-@dataclass
-class ContactGeometry:
-    """Per-point geometry: arrays of shape (N, P, ...) with P = 1 (2D) or 2 (LE, TE)."""
-
-    points: np.ndarray  # (N, P, 3) rest positions, rotating frame, z from the blade-tip plane
-    normals: np.ndarray  # (N, P, 3) outward casing normal
-    tangents: np.ndarray  # (N, P, 3) e_t at the point
-    Jb: np.ndarray  # (N, P, 3, n) blade-point displacement maps
-    Jc: np.ndarray  # (N, P, 3, n) casing-point displacement maps
-    chord: float  # l_c (0 for the point law)
 
 
 @dataclass
@@ -57,7 +48,7 @@ class ContactModel:
 
     Examples
     --------
-    >>> from rotorub_model.model import build_model
+    >>> from rotorub_model.structure.model import build_model
     >>> m = build_model()
     >>> c = make_contact(m, "3D")
     >>> c.gaps(np.zeros(m.n_dofs)).shape
@@ -201,9 +192,6 @@ def make_contact(model: Model, formulation: str = "3D", variant: str = "full", *
     Variants (paper section 4): 'full'; 'kinematics_only' (theta = 0, l_c = 1 mm);
     'geometry_only' (no disk or casing rotation, no blade flexure in the gap).
     """
-    from .contact2d import geometry_2d
-    from .contact3d import geometry_3d
-
     if formulation not in FORMULATIONS:
         raise ParameterError(f"formulation: '{formulation}' unknown; accepted: {', '.join(FORMULATIONS)}")
     if variant not in VARIANTS:

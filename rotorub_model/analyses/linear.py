@@ -15,7 +15,7 @@ the fixed frame at |w + m Omega|; the dominant component labels the mode.
 
 Examples
 --------
->>> from rotorub_model.model import build_model
+>>> from rotorub_model.structure.model import build_model
 >>> r = run_response(build_model(), n_speeds=400)
 >>> len(r.critical_speeds)
 2
@@ -30,9 +30,9 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 from scipy.signal import find_peaks
 
-from .errors import ParameterError
-from .model import Model
-from .results import pyplot, save_figure, write_json
+from ..errors import ParameterError
+from ..results import pyplot, save_figure, write_json
+from ..structure.model import Model
 
 
 def linear_response(model: Model, omega: float, me: float | None = None) -> np.ndarray:

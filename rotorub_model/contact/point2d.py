@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .blades import blade_angles
-from .casing import casing_point_map
-from .contact import ContactGeometry
-from .model import Model
+from ..structure.blades import blade_angles
+from ..structure.casing import casing_point_map
+from ..structure.model import Model
+from .geometry import ContactGeometry
 
 
 def geometry_2d(model: Model) -> ContactGeometry:

@@ -6,7 +6,7 @@ module only places them. Rotor and casing are coupled only through contact.
 
 Examples
 --------
->>> from rotorub_model.model import build_model
+>>> from rotorub_model.structure.model import build_model
 >>> m = build_model()
 >>> m.n_dofs
 38

@@ -14,7 +14,7 @@ always says whether it converged and with what residual.
 
 Examples
 --------
->>> from rotorub_model.model import build_model
+>>> from rotorub_model.structure.model import build_model
 >>> from rotorub_model.contact import make_contact
 >>> m = build_model()
 >>> r = solve_static(m, make_contact(m, "3D", g0=0.2e-3), 3.3 * 53.4)
@@ -28,9 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .contact import ContactModel
-from .errors import ConvergenceError, ParameterError
-from .model import Model
+from ..contact import ContactModel
+from ..errors import ConvergenceError, ParameterError
+from ..structure.model import Model
 
 
 @dataclass

@@ -13,9 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .contact import ContactModel
+from ..contact import ContactModel
+from ..structure.model import Model
 from .linear import first_order
-from .model import Model
 
 # A real part below this (1/s) is round-off of a neutral mode, not an instability.
 RE_TOL = 1e-6
