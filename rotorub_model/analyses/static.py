@@ -19,7 +19,7 @@ Examples
 >>> m = build_model()
 >>> r = solve_static(m, make_contact(m, "3D", g0=0.2e-3), 3.3 * 53.4)
 >>> r.converged, r.n_contact
-(True, 3)
+(True, 4)
 """
 
 from __future__ import annotations
