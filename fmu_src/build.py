@@ -5,7 +5,11 @@
 The FMU carries, in its resources folder:
 
 * ``rotorub_casing_contact_<h>.py``: the pythonfmu slave (fmu_src/rotorub_casing_contact.py);
-* ``rotorub_model_<h>/``: a verbatim copy of the ``rotorub_model`` sources and data;
+* ``rotorub_model_<h>/``: a verbatim copy of the ``rotorub_model`` sources and data, with
+  the compiled kernel in ``kernel/bin/<machine>-<os>/`` (x86_64-linux, and x86_64-win when
+  ziglang can cross-compile it: the platforms pythonfmu's binary exists for);
+* ``model.npz``: the model assembled from the parameter file at build time (the host needs
+  only numpy to run it; a ``param_file`` given at run time is assembled there, with scipy);
 * ``reference.toml``: the parameter file used when the ``param_file`` parameter is empty
   (the embedded reference, or the file given with --params);
 * ``rotorub_fmu.json``: which package/parameter file to load and the number of blades;
@@ -38,7 +42,11 @@ import rotorub_model  # noqa: E402 - the sources that travel inside the FMU, whe
 
 LIB = Path(rotorub_model.__file__).resolve().parent
 MODEL_IDENTIFIER = "RotorCasingContact"
-HOST_REQUIREMENTS = ["numpy>=1.26", "scipy>=1.11", "numba>=0.59"]
+HOST_REQUIREMENTS = ["numpy>=1.26"]
+# scipy is needed only to assemble a model from a param_file other than the one built in
+OPTIONAL_REQUIREMENTS = ["scipy>=1.11"]
+# pythonfmu 0.7 ships its binary for these FMI platforms; the kernel is built for each (cross: ziglang)
+KERNEL_PLATFORMS = {"linux64": "x86_64-linux", "win64": "x86_64-win"}
 
 
 class BuildError(Exception):
@@ -47,7 +55,7 @@ class BuildError(Exception):
 
 def _library_files() -> list[Path]:
     files = [p for p in sorted(LIB.rglob("*")) if p.is_file() and "__pycache__" not in p.parts
-             and p.suffix in (".py", ".toml")]
+             and "bin" not in p.relative_to(LIB).parts and p.suffix in (".py", ".toml", ".c", ".h")]
     if not (LIB / "__init__.py").exists():
         raise BuildError(f"library sources not found in {LIB}")
     return files
@@ -127,14 +135,55 @@ or 1 (diverged). The instance stays usable: corrected inputs, fmi2SetFMUstate or
         shutil.copy2(fmu_md, doc / "FMU.md")
 
 
-def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None) -> dict:
-    """Build ``dest/RotorCasingContact.fmu``; returns a summary dict. Needs pythonfmu."""
+def _kernel_binaries(pkg: Path, platforms: tuple[str, ...] | None) -> list[str]:
+    """Compile the kernel into the library copy for each FMI platform; returns the platforms built.
+
+    ``platforms=None``: this machine's, plus the cross builds ziglang can make (a warning, not an
+    error, when it cannot: the FMU then runs where it was built and on any host with a compiler).
+    """
+    from rotorub_model import kernel
+    from rotorub_model.kernel.compiler import CompilerError, host_platform_tag, zig_command
+
+    host = host_platform_tag()
+    host_fmi = next((f for f, tag in KERNEL_PLATFORMS.items() if tag == host), None)
+    wanted = list(platforms) if platforms is not None else [f for f in KERNEL_PLATFORMS if f == host_fmi
+                                                            or zig_command() is not None]
+    built = []
+    for fmi in wanted:
+        if fmi not in KERNEL_PLATFORMS:
+            raise BuildError(f"platform '{fmi}': unknown; accepted: {', '.join(KERNEL_PLATFORMS)}")
+        tag = KERNEL_PLATFORMS[fmi]
+        out = pkg / "kernel" / "bin" / tag / ("rotorub_kernel" + (".dll" if tag.endswith("win") else ".so"))
+        try:
+            if fmi == host_fmi:
+                kernel.load()  # built (or found) in the user cache: copy that one
+                out.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copy2(kernel.cache_dir() / f"kernel-{kernel.source_id()}-{tag}.so", out)
+            else:
+                kernel.build(out, target=fmi)
+        except CompilerError as exc:
+            if platforms is not None:
+                raise BuildError(f"kernel for {fmi}: {exc}") from None
+            print(f"build-fmu: warning: no kernel binary for {fmi} ({exc})", file=sys.stderr)
+            continue
+        built.append(fmi)
+    return built
+
+
+def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
+              platforms: tuple[str, ...] | None = None) -> dict:
+    """Build ``dest/RotorCasingContact.fmu``; returns a summary dict. Needs pythonfmu.
+
+    ``platforms``: FMI platforms to compile the kernel for (default: this one, plus win64 when
+    ziglang is installed).
+    """
     try:
         from pythonfmu import FmuBuilder
         from pythonfmu import __version__ as pythonfmu_version
     except ImportError:
         raise BuildError("pythonfmu is not installed: pip install 'rotorub[fmu]'") from None
     from rotorub_model import __version__ as lib_version
+    from rotorub_model.structure.model import build_model, save_model
     from rotorub_model.structure.params import load_parameters
 
     params_path = Path(params_file) if params_file else LIB / "data" / "reference.toml"
@@ -152,8 +201,9 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None) 
     lib_name = f"rotorub_model_{tag}"
     module_name = f"rotorub_casing_contact_{tag}"
     manifest = {"library": lib_name, "library_version": lib_version, "parameters": "reference.toml",
-                "n_blades": params.blades.count, "build": tag, "pythonfmu": pythonfmu_version,
-                "host_requirements": HOST_REQUIREMENTS}
+                "model": "model.npz", "n_blades": params.blades.count, "build": tag,
+                "pythonfmu": pythonfmu_version, "host_requirements": HOST_REQUIREMENTS,
+                "optional_requirements": OPTIONAL_REQUIREMENTS}
 
     added_modules = set()
     before = set(sys.modules)
@@ -171,6 +221,8 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None) 
             else:
                 shutil.copy2(p, out)
         shutil.copy2(params_path, stage / "reference.toml")
+        save_model(build_model(params), stage / "model.npz")
+        manifest["kernel_platforms"] = _kernel_binaries(pkg, platforms)
         (stage / "rotorub_fmu.json").write_text(json.dumps(manifest, indent=1))
         (stage / "requirements.txt").write_text("\n".join(HOST_REQUIREMENTS) + "\n")
         script = stage / f"{module_name}.py"
@@ -181,7 +233,8 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None) 
         try:
             FmuBuilder.build_FMU(
                 script, dest=out_file,
-                project_files=[pkg, stage / "reference.toml", stage / "rotorub_fmu.json", stage / "requirements.txt"],
+                project_files=[pkg, stage / "reference.toml", stage / "model.npz", stage / "rotorub_fmu.json",
+                               stage / "requirements.txt"],
                 documentation_folder=Path(tmp) / "documentation",
                 canGetAndSetFMUstate=True, canSerializeFMUstate=True,
             )
@@ -198,7 +251,8 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None) 
         md = z.read("modelDescription.xml").decode()
     return {"fmu": str(out_file), "size_bytes": out_file.stat().st_size, "files": len(names),
             "variables": md.count("<ScalarVariable"), "blades": params.blades.count, "build": tag,
-            "parameters": str(params_path), "host_requirements": HOST_REQUIREMENTS}
+            "parameters": str(params_path), "host_requirements": HOST_REQUIREMENTS,
+            "kernel_platforms": manifest["kernel_platforms"]}
 
 
 def _variables(stage: Path, module_name: str) -> list[tuple]:

@@ -7,9 +7,9 @@ in the FMU's resources folder (imported under a build-specific package name so i
 never collides with another copy of the library, or with another pythonfmu FMU,
 in the same interpreter):
 
-* transient mode: :class:`CentralDifference` (``advance`` substeps inside each
-  communication step, ``get_state``/``set_state`` for rollback) and
-  :func:`outputs_from_q` for the per-blade and global outputs;
+* transient mode: :class:`CentralDifference`: one call of the compiled kernel per
+  communication step does the substeps and writes every output straight into this
+  slave's value buffer (``get_state``/``set_state`` for rollback);
 * quasi-static mode: :func:`solve_static` warm-started from the previous step and
   :func:`stability_of` for the largest real part of the eigenvalues.
 
@@ -54,10 +54,10 @@ UNITS = {
 
 # submodules of the bundled library imported eagerly: a later lazy import must not
 # depend on the folder it came from still existing (masters delete extracted FMUs)
-_LIB_MODULES = ("errors", "results", "structure.params", "structure.frames", "structure.ritz", "structure.shaft",
-                "structure.blades", "structure.casing", "structure.model", "contact.laws", "contact.geometry",
-                "contact.point2d", "contact.chord3d", "contact.contact_model", "contact", "analyses.linear",
-                "analyses.transient", "analyses.static", "analyses.stability")
+_LIB_MODULES = ("errors", "results", "kernel.compiler", "kernel", "structure.params", "structure.frames",
+                "structure.ritz", "structure.shaft", "structure.blades", "structure.casing", "structure.model",
+                "contact.geometry", "contact.point2d", "contact.chord3d", "contact.contact_model", "contact",
+                "analyses.linear", "analyses.transient", "analyses.static", "analyses.stability")
 
 
 def _load_library(resources: Path) -> tuple[dict, object]:
@@ -120,13 +120,13 @@ class RotorCasingContact(Fmi2Slave):
         for i, spec in enumerate(self._specs):
             self._register(i, spec)
         nb = self._n_blades
-        self._out_slots = {k: np.array([self._slot[f"blade[{j + 1}].{k}"] for j in range(nb)])
-                           for k in ("F_N", "F_T", "gap_LE", "gap_TE", "gap_tip", "contact_fraction")}
-        self._blade_idx = np.concatenate([self._out_slots[k] for k in
-                                          ("F_N", "F_T", "contact_fraction", "gap_LE", "gap_TE", "gap_tip")])
-        self._global_idx = np.array([self._slot[k] for k in (
-            "casing_force.x", "casing_force.y", "casing_force.z", "friction_torque", "disk_displacement.x",
-            "disk_displacement.y", "gap_min", "max_real_eig")])
+        # where the kernel writes each output of a state (its layout -> this slave's value buffer);
+        # n_contact lands in the Real buffer's unused slot of that Integer and is copied over
+        kern = self._lib.kernel
+        self._out_index = np.array([self._slot[f"blade[{j + 1}].{b}"] for b in kern.OUT_BLADE_NAMES
+                                    for j in range(nb)] + [self._slot[g] for g in kern.OUT_GLOBAL_NAMES],
+                                   dtype=np.intc)
+        self._n_contact_slot = self._slot["n_contact"]
         self._phase = "instantiated"  # -> initialization -> step
         self._t = 0.0  # current communication point
         self._sim = None  # runtime objects, built at the end of initialization
@@ -355,10 +355,13 @@ class RotorCasingContact(Fmi2Slave):
         g0 = self._r("g0")
         params = params.replace(contact={"g0": g0, "k_r": cfg["k_r"], "mu": cfg["mu"],
                                          "theta_deg": math.degrees(cfg["theta"]), "chord": cfg["chord"]})
-        model = lib.model.build_model(params)
+        if path:
+            model = lib.model.build_model(params)  # assembling a model needs scipy (component modes)
+        else:  # the matrices baked at build time: no assembly, numpy only
+            model = lib.model.load_model(self._resources / self._manifest["model"], params)
         contact = lib.contact.make_contact(model, cfg["formulation"])
         sim = {"config": cfg, "model": model, "contact": contact, "g0": g0, "phi": 0.0, "q_static": None,
-               "limit": (None, None), "T2": np.ascontiguousarray(model.disk_maps[0][:2])}
+               "limit": (None, None)}
         if cfg["mode"] == "transient":
             omega0 = self._r("Omega")
             w = omega0 if math.isfinite(omega0) and omega0 >= 0 else 0.0
@@ -461,7 +464,8 @@ class RotorCasingContact(Fmi2Slave):
                 v = cd.velocity()
                 cd.dt = dt_new
                 cd.q_prev[:] = cd.q - dt_new * v
-        done, _ = cd.advance(n, omega, me)
+        done, _ = cd.advance(n, omega, me, out_index=self._out_index, out_dest=self._rv)
+        self._iv[self._n_contact_slot] = int(self._rv[self._n_contact_slot])
         self._rv[self._slot["dt_internal"]] = cd.dt
         self._iv[self._slot["n_substeps"]] = done
         if cd.diverged or done < n:
@@ -470,7 +474,6 @@ class RotorCasingContact(Fmi2Slave):
                          f"below -{pen * 1e3:g} mm (blade through the casing liner, penalty contact meaningless) "
                          "or the state stopped being finite; outputs hold the last good step")
             return False
-        self._write_outputs(cd.q, cd.phi, max_real=0.0)
         return True
 
     def _quasi_static(self, omega: float, me: float, h: float) -> tuple[bool, str]:
@@ -489,19 +492,10 @@ class RotorCasingContact(Fmi2Slave):
         return True, ""
 
     def _write_outputs(self, q: np.ndarray, phi: float, max_real: float) -> None:
-        """The outputs of the library's :func:`outputs_from_q` for one state (ContactModel.outputs,
-        the fan-disk map of Model.disk_maps, the rotation to the fixed frame)."""
-        sim = self._sim
-        o = sim["contact"].outputs(q)
-        c, s = math.cos(phi), math.sin(phi)
-        dx, dy = sim["T2"] @ q
-        Fx, Fy, Fz = o["casing_force"]
-        FN, gap = o["F_N"], o["gap"]
-        tip = gap.min(axis=1)
-        self._rv[self._blade_idx] = np.concatenate((FN, o["F_T"], o["fraction"], gap[:, 0], gap[:, -1], tip))
-        self._rv[self._global_idx] = (c * Fx - s * Fy, s * Fx + c * Fy, Fz, o["friction_torque"],
-                                      c * dx - s * dy, s * dx + c * dy, tip.min(), max_real)
-        self._iv[self._slot["n_contact"]] = np.count_nonzero(FN > 0)
+        """The outputs of state q (the kernel's, as in every library analysis), fixed frame at angle phi."""
+        self._sim["contact"].write_outputs(q, phi, self._out_index, self._rv)
+        self._iv[self._n_contact_slot] = int(self._rv[self._n_contact_slot])
+        self._rv[self._slot["max_real_eig"]] = max_real
 
     # ------------------------------------------------------------------ FMU state (rollback)
     def _get_fmu_state(self):

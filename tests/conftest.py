@@ -23,7 +23,7 @@ def contact_fmu(tmp_path_factory):
     pytest.importorskip("pythonfmu", reason="building the FMU needs pythonfmu (pip install -e '.[fmu]')")
     from fmu_src.build import build_fmu
 
-    return build_fmu(tmp_path_factory.mktemp("contact_fmu"))["fmu"]
+    return build_fmu(tmp_path_factory.mktemp("contact_fmu"), platforms=("linux64",))["fmu"]
 
 
 @pytest.fixture(scope="session")

@@ -1,4 +1,4 @@
-"""Contact formulations (contact.py, contact2d.py, contact3d.py, contact_law.py): tests
+"""Contact formulations (contact/ and the kernel's laws): tests
 that fail if the physics is wrong (MODEL-NOTES section 2)."""
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ import pytest
 
 from rotorub_model.analyses.linear import linear_response, run_response
 from rotorub_model.contact import ContactModel, make_contact
-from rotorub_model.contact.laws import chord_law
 from rotorub_model.errors import ParameterError
+from rotorub_model.kernel import chord_law
 from rotorub_model.structure.model import build_model
 from rotorub_model.structure.params import reference_parameters
 
@@ -235,7 +235,7 @@ def test_chord_law_continuous_across_fronts(fixed, moving):
 
 
 def test_point_law_and_fraction():
-    from rotorub_model.contact.laws import point_law
+    from rotorub_model.kernel import point_law
 
     assert point_law(-2e-3, K_R) == (pytest.approx(2e-3 * K_R), -K_R)
     assert point_law(1e-3, K_R) == (0.0, 0.0)

@@ -144,14 +144,10 @@ def host(tmp_path_factory) -> Path:
 
 
 def _host_env(preload: Path | None) -> dict:
-    """What a native host process needs for this FMU: Python's home, the folders of numpy/scipy/numba, libpython."""
-    import numba
-    import scipy
-
+    """What a native host process needs for this FMU: Python's home, the folder of numpy, libpython."""
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONSTARTUP", "PYTHONHOME", "PYTHONPATH")}
     env["PYTHONHOME"] = sys.base_prefix
-    env["PYTHONPATH"] = os.pathsep.join(dict.fromkeys(str(Path(m.__file__).resolve().parents[1])
-                                                      for m in (np, scipy, numba)))
+    env["PYTHONPATH"] = str(Path(np.__file__).resolve().parents[1])
     if preload is not None:
         env["LD_PRELOAD"] = str(preload)
     else:

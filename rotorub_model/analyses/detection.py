@@ -74,7 +74,8 @@ def linear_responses(model: Model, omegas: np.ndarray, me: float | None = None) 
 def closure(contact: ContactModel, Q: np.ndarray) -> np.ndarray:
     """Clearance closure c(Omega) = max over contact points of -(G q(Omega)) [m], for the
     responses Q (n_speeds, n_dofs): contact at (Omega, g0) iff g0 < c(Omega)."""
-    return np.max(-(Q @ contact.G.T), axis=1)
+    gaps = contact.with_clearance(0.0).gaps_batch(Q)  # the kernel's gaps, g0 = 0
+    return np.max(-gaps.reshape(gaps.shape[0], -1), axis=1)
 
 
 def contact_map(closures: np.ndarray, g0: np.ndarray) -> np.ndarray:

@@ -27,8 +27,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.optimize import minimize_scalar
-from scipy.signal import find_peaks
 
 from ..errors import ParameterError
 from ..results import pyplot, save_figure, write_json
@@ -108,6 +106,9 @@ def run_response(
     model: Model, speed_min: float = 0.05, speed_max: float = 10.0, n_speeds: int = 2000, me: float | None = None
 ) -> ResponseResult:
     """Imbalance response over normalised speeds [speed_min, speed_max], with refined peaks."""
+    from scipy.optimize import minimize_scalar  # here: the FMU's copy of this module must import without scipy
+    from scipy.signal import find_peaks
+
     _check_speed_range(speed_min, speed_max, n_speeds)
     wref = model.params.normalisation.omega_ref
     speeds = np.linspace(speed_min, speed_max, n_speeds)

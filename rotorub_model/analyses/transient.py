@@ -9,8 +9,9 @@ Central differences (q' = (q+ - q-)/2dt, q'' = (q+ - 2q + q-)/dt^2):
 
 C = D + G. The contact force is evaluated at the current q only, so the scheme
 is explicit; the left-hand matrix is constant for a constant Omega and is
-inverted once. The loop runs compiled (numba): per step three dense mat-vecs and
-the contact law.
+inverted once. The loop runs in the compiled kernel (``rotorub_model/kernel``): per
+step three dense mat-vecs and the contact law; the outputs of each recorded state are
+computed there too, so a run is one call into C.
 
 Spin-speed histories Omega(t): Omega is held over short segments (``segment``
 seconds, 1 ms by default) and the matrices are rebuilt per segment; the
@@ -29,91 +30,19 @@ or a value stops being finite; the result says so and when.
 
 from __future__ import annotations
 
+import ctypes
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from numba import njit
 
+from .. import kernel
 from ..contact import ContactModel
-from ..contact.laws import blade_laws
 from ..errors import ParameterError
 from ..results import pyplot, save_figure, write_json
 from ..structure.model import Model
-
-
-@njit(cache=True)
-def _cd_segment(q_prev, q, n_steps, Ainv, K2, Cm1, f_imb, t0, dt, t_ramp, me_ratio0, G, g0, A, B, Cc, Dc,
-                mu, k, chord, n_pts, rec_every, step0, rec_q, rec_start, max_pen):
-    """Advance n_steps; returns (steps done, records written, diverged flag)."""
-    n = q.shape[0]
-    nb = A.shape[0]
-    gaps = np.empty((nb, n_pts))
-    law = np.empty((nb, 7))
-    rhs = np.empty(n)
-    n_rec = rec_start
-    for i in range(n_steps):
-        t = t0 + i * dt
-        r = 1.0 if (t_ramp <= 0.0 or t >= t_ramp) else t / t_ramp
-        r *= me_ratio0
-        # gaps and contact law
-        for row in range(nb * n_pts):
-            s = g0
-            for c in range(n):
-                s += G[row, c] * q[c]
-            gaps[row // n_pts, row % n_pts] = s
-        blade_laws(gaps, k, chord, n_pts == 2, law)
-        diverged = False
-        for j in range(nb):
-            for p in range(n_pts):
-                if not (gaps[j, p] > -max_pen):
-                    diverged = True
-        if diverged:
-            return i, n_rec, True
-        # rhs = r F + F_nl + K2 q - Cm1 q_prev
-        for c in range(n):
-            s = r * f_imb[c]
-            for j in range(nb):
-                FN = law[j, 0]
-                MN = law[j, 1]
-                s += A[j, c] * FN + B[j, c] * MN - mu * (Cc[j, c] * FN + Dc[j, c] * MN)
-            for e in range(n):
-                s += K2[c, e] * q[e] - Cm1[c, e] * q_prev[e]
-            rhs[c] = s
-        for c in range(n):
-            q_prev[c] = q[c]
-        for c in range(n):
-            s = 0.0
-            for e in range(n):
-                s += Ainv[c, e] * rhs[e]
-            q[c] = s
-        if (step0 + i + 1) % rec_every == 0 and n_rec < rec_q.shape[0]:
-            for c in range(n):
-                rec_q[n_rec, c] = q[c]
-            n_rec += 1
-    return n_steps, n_rec, False
-
-
-@njit(cache=True)
-def _linear_cd(q_prev, q, n_steps, Ainv, K2, Cm1, f):
-    """The bare linear central-difference update (benchmark reference)."""
-    n = q.shape[0]
-    rhs = np.empty(n)
-    for _ in range(n_steps):
-        for c in range(n):
-            s = f[c]
-            for e in range(n):
-                s += K2[c, e] * q[e] - Cm1[c, e] * q_prev[e]
-            rhs[c] = s
-        for c in range(n):
-            q_prev[c] = q[c]
-        for c in range(n):
-            s = 0.0
-            for e in range(n):
-                s += Ainv[c, e] * rhs[e]
-            q[c] = s
 
 
 def all_closed_stiffness(contact: ContactModel) -> np.ndarray:
@@ -132,7 +61,9 @@ class CentralDifference:
     """A central-difference integrator with state, stepping at constant inputs.
 
     The FMU and :func:`run_transient` both drive this object. State: (t, q, q_prev,
-    phi) with phi the rotation angle of the rotating frame (for fixed-frame outputs).
+    phi) with phi the rotation angle of the rotating frame (for fixed-frame outputs);
+    it lives in the kernel's ``rr_cd_state`` (t, dt, phi, steps, diverged) and in the
+    arrays ``q``, ``q_prev`` (updated in place: never rebind them).
 
     Parameters
     ----------
@@ -148,22 +79,25 @@ class CentralDifference:
             raise ParameterError(f"max_penetration: {max_penetration} out of range; accepted range (0, inf) m")
         self.model, self.contact = model, contact
         self.t_ramp = float(t_ramp)
-        self.max_penetration = max_penetration
         self.user_dt = dt
         w = omega_max_for_dt if omega_max_for_dt is not None else 0.0
         self.dt_limit = critical_time_step(model, contact, w)
-        self.dt = self._check_dt(dt, self.dt_limit)
         n = model.n_dofs
-        self.t = 0.0
-        self.steps = 0
-        self.phi = 0.0
         self.q = np.zeros(n)
         self.q_prev = np.zeros(n)
-        self.diverged = False
+        self._s = kernel.RRState(0.0, self._check_dt(dt, self.dt_limit), 0.0, float(max_penetration), 0, 0,
+                                 kernel.ptr(self.q), kernel.ptr(self.q_prev))
         self._key = None
         self._mats = None
-        self._geom = None
-        self._set_contact_arrays()
+        self._no_rec = np.empty((0, n))
+
+    # the scheme's scalars live in the kernel's state struct
+    t = property(lambda self: self._s.t, lambda self, v: setattr(self._s, "t", float(v)))
+    dt = property(lambda self: self._s.dt, lambda self, v: setattr(self._s, "dt", float(v)))
+    phi = property(lambda self: self._s.phi, lambda self, v: setattr(self._s, "phi", float(v)))
+    steps = property(lambda self: self._s.steps, lambda self, v: setattr(self._s, "steps", int(v)))
+    diverged = property(lambda self: bool(self._s.diverged), lambda self, v: setattr(self._s, "diverged", int(v)))
+    max_penetration = property(lambda self: self._s.max_pen)
 
     @staticmethod
     def _check_dt(dt: float | None, limit: float) -> float:
@@ -178,32 +112,25 @@ class CentralDifference:
             )
         return float(dt)
 
-    def _set_contact_arrays(self) -> None:
-        c = self.contact
-        self._geom = (
-            np.ascontiguousarray(c.G), float(c.g0), np.ascontiguousarray(c.A), np.ascontiguousarray(c.B),
-            np.ascontiguousarray(c.C), np.ascontiguousarray(c.D), float(c.mu), float(c.k_r),
-            float(max(c.geometry.chord, 1e-300)), int(c.n_points),
-        )
-
     def set_clearance(self, g0: float) -> None:
         """Change the nominal clearance between steps (gaps are affine in g0)."""
         if not math.isfinite(g0):
             raise ParameterError(f"g0: {g0} is not finite; accepted range (-l_b/2, inf) m")
         self.contact = self.contact.with_clearance(g0)
-        self._set_contact_arrays()
 
-    def _matrices(self, omega: float, omega_dot: float):
+    def _matrices(self, omega: float, omega_dot: float) -> kernel.RRMatrices:
         key = (omega, omega_dot, self.dt)
         if key != self._key:
             m, dt = self.model, self.dt
             C = m.D + m.G(omega)
             K = m.K_omega(omega) + omega_dot * m.E1
             Aeff = m.M / dt**2 + C / (2 * dt)
-            self._mats = (np.linalg.inv(Aeff), 2 * m.M / dt**2 - K, m.M / dt**2 - C / (2 * dt),
-                          np.ascontiguousarray(m.force(omega, 1.0, omega_dot)))
+            arrays = (np.linalg.inv(Aeff), 2 * m.M / dt**2 - K, m.M / dt**2 - C / (2 * dt),
+                      np.ascontiguousarray(m.force(omega, 1.0, omega_dot)))
+            arrays = tuple(np.ascontiguousarray(a, dtype=float) for a in arrays)
+            self._mats = (kernel.RRMatrices(m.n_dofs, *map(kernel.ptr, arrays)), arrays)
             self._key = key
-        return self._mats
+        return self._mats[0]
 
     def ensure_stable_dt(self, omega: float) -> None:
         """Re-check (and, for the automatic choice, adapt) the step at a new speed."""
@@ -216,23 +143,29 @@ class CentralDifference:
         self.dt_limit = min(self.dt_limit, limit)
 
     def advance(self, n_steps: int, omega: float, me: float, omega_dot: float = 0.0,
-                rec_every: int = 0, rec_q: np.ndarray | None = None, rec_start: int = 0) -> tuple[int, int]:
-        """Advance n_steps at constant inputs; returns (steps done, records written)."""
-        if self.diverged:
+                rec_every: int = 0, rec_q: np.ndarray | None = None, rec_start: int = 0,
+                rec_out: np.ndarray | None = None, out_index: np.ndarray | None = None,
+                out_dest: np.ndarray | None = None) -> tuple[int, int]:
+        """Advance n_steps at constant inputs in one kernel call; returns (steps done, records written).
+
+        Records: every ``rec_every``-th step of the run, q into ``rec_q`` and (if given) the
+        outputs of the state (rotating frame, kernel layout) into ``rec_out``, from row
+        ``rec_start``. ``out_dest``: the outputs of the final state, fixed frame, written
+        through ``out_index`` (an FMU's value buffer).
+        """
+        if self._s.diverged:
             return 0, rec_start
-        Ainv, K2, Cm1, f = self._matrices(omega, omega_dot)
+        mats = self._matrices(omega, omega_dot)
         if rec_q is None:
-            rec_q = np.empty((0, self.model.n_dofs))
-            rec_every = max(n_steps, 1)
-        done, n_rec, div = _cd_segment(
-            self.q_prev, self.q, int(n_steps), Ainv, K2, Cm1, f, self.t, self.dt, self.t_ramp, float(me),
-            *self._geom, int(max(rec_every, 1)), self.steps, rec_q, int(rec_start), self.max_penetration,
-        )
-        self.steps += done
-        self.t += done * self.dt
-        self.phi += done * self.dt * omega
-        self.diverged = bool(div)
-        return done, n_rec
+            rec_q, rec_every = self._no_rec, max(n_steps, 1)
+        n_rec = ctypes.c_int(rec_start)
+        c = self.contact
+        done = c.lib.rr_cd_advance(
+            ctypes.byref(self._s), c.kernel, ctypes.byref(mats), int(n_steps), float(omega), float(me),
+            self.t_ramp, int(max(rec_every, 1)), int(rec_q.shape[0]), kernel.ptr(rec_q),
+            None if rec_out is None else kernel.ptr(rec_out), ctypes.byref(n_rec),
+            None if out_index is None else kernel.iptr(out_index), None if out_dest is None else kernel.ptr(out_dest))
+        return done, n_rec.value
 
     # state for rollback (FMU get/set state)
     def get_state(self) -> tuple:
@@ -261,33 +194,25 @@ def rotate_to_fixed(v: np.ndarray, phi: np.ndarray | float) -> np.ndarray:
     return out
 
 
-def outputs_from_q(model: Model, contact: ContactModel, q: np.ndarray, phi: np.ndarray) -> dict[str, np.ndarray]:
-    """Physical outputs for states q (nt, n) at frame angles phi (nt,)."""
-    nt = q.shape[0]
-    N, P = contact.n_blades, contact.n_points
-    FN = np.zeros((nt, N))
-    frac = np.zeros((nt, N))
-    gaps = np.zeros((nt, N, P))
-    Fc = np.zeros((nt, 3))
-    torque = np.zeros(nt)
-    for i in range(nt):
-        o = contact.outputs(q[i])
-        FN[i], frac[i], gaps[i] = o["F_N"], o["fraction"], o["gap"]
-        Fc[i] = o["casing_force"]
-        torque[i] = o["friction_torque"]
-    T, _ = model.disk_maps
+def outputs_from_q(model: Model, contact: ContactModel, q: np.ndarray, phi: np.ndarray,
+                   rotating: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """Physical outputs for states q (nt, n) at frame angles phi (nt,).
+
+    ``rotating``: the kernel's outputs of these states (rotating frame), if already
+    computed (the transient records them as it goes); else one batched kernel call.
+    """
+    o = contact.split_outputs(contact.outputs_array(q) if rotating is None else rotating)
     cs = model.slices["casing"]
-    disk = (T[:2] @ q.T).T
     casing = q[:, cs][:, :2]
     return {
-        "F_N": FN,
-        "F_T": contact.mu * FN,
-        "fraction": frac,
-        "gap": gaps,
-        "disk_fixed": rotate_to_fixed(disk, phi),
+        "F_N": o["F_N"],
+        "F_T": o["F_T"],
+        "fraction": o["fraction"],
+        "gap": o["gap"],
+        "disk_fixed": rotate_to_fixed(o["disk"], phi),
         "casing_fixed": rotate_to_fixed(casing, phi),
-        "casing_force_fixed": rotate_to_fixed(Fc, phi),
-        "friction_torque": torque,
+        "casing_force_fixed": rotate_to_fixed(o["casing_force"], phi),
+        "friction_torque": o["friction_torque"],
     }
 
 
@@ -413,6 +338,7 @@ def run_transient(
     rec_every = max(1, int(round(record_dt / dt_)))
     n_rec = n_total // rec_every
     rec_q = np.zeros((n_rec, model.n_dofs))
+    rec_out = np.zeros((n_rec, contact.n_outputs))
     constant = not callable(omega)
     seg_steps = n_total if constant else max(1, int(round(segment / dt_)))
     if hold is not None:
@@ -435,7 +361,8 @@ def run_transient(
             w_dot = 0.0 if constant else (omega_fn(t_b) - omega_fn(t_a)) / (t_b - t_a)
             me_k = me
         before = written
-        done, written = integ.advance(n, w_mid, me_k, w_dot, rec_every=rec_every, rec_q=rec_q, rec_start=written)
+        done, written = integ.advance(n, w_mid, me_k, w_dot, rec_every=rec_every, rec_q=rec_q, rec_start=written,
+                                      rec_out=rec_out)
         if hold is not None and written > before:
             phi_rec.append(integ.phi)
         done_total += done
@@ -455,7 +382,7 @@ def run_transient(
         phi = om * t_rec
     else:  # frame angle: trapezoidal integral of the spin-speed history
         phi = om[0] * t_rec[0] + np.concatenate([[0.0], np.cumsum(0.5 * (om[1:] + om[:-1]) * np.diff(t_rec))])
-    outs = outputs_from_q(model, integ.contact, q_rec, phi)
+    outs = outputs_from_q(model, integ.contact, q_rec, phi, rotating=rec_out[:written])
     msg = (
         f"diverged at t = {integ.t:.4f} s: penetration beyond {max_penetration * 1e3:g} mm"
         if integ.diverged

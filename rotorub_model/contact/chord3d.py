@@ -60,4 +60,4 @@ def geometry_3d(model: Model, theta: float, chord: float, rotations: bool = True
             else:
                 D[:, 2:4] = 0.0
             Jc[j, k][:, cs] = D
-    return ContactGeometry(pts, nor, tan, Jb, Jc, chord)
+    return ContactGeometry(pts, nor, tan, Jb, Jc, chord, np.ascontiguousarray(T[:2]))

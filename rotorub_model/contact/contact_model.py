@@ -13,7 +13,7 @@ The 3D gap of eq. (4) linearised about the rest position is exactly this with
 n = cos(theta) e_rho + sin(theta) e_z (the cone's normal): the cone is kept, its
 curvature terms (order d^2 / R ~ 1e-5 m for millimetre motion) are dropped.
 
-Forces (virtual work of the pressure on the gap's derivatives, see contact_law):
+Forces (virtual work of the pressure on the gap's derivatives; the laws run in the kernel):
 the normal pressure on the blade is -p_N n, on the casing +p_N n, so its virtual
 work is int p_N d gap(c) dc, and the friction pressure's is -int p_T dt(c) dc:
 
@@ -31,11 +31,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import kernel
 from ..errors import ParameterError
 from ..structure.model import Model
 from .chord3d import geometry_3d
 from .geometry import ContactGeometry
-from .laws import blade_laws
 from .point2d import geometry_2d
 
 FORMULATIONS = ("2D", "3D")
@@ -84,7 +84,6 @@ class ContactModel:
             self.B = np.zeros_like(self.A)
             self.C = Tk[:, 0]
             self.D = np.zeros_like(self.A)
-        self._out = np.zeros((self.n_blades, 7))
         # The casing resultant and the rotor torque are linear in (F_N, M_N) of each blade:
         # precompute those maps once so per-state outputs cost two small products.
         nc = g.normals + self.mu * g.tangents  # (N, P, 3) force direction per unit weight, on the casing
@@ -99,44 +98,92 @@ class ContactModel:
         else:
             self._res_F, self._res_M = nc[:, 0], np.zeros_like(nc[:, 0])
             self._tq_F, self._tq_M = arm[:, 0], np.zeros_like(arm[:, 0])
+        self._k = None
+
+    # ------------------------------------------------------------------ the kernel's view
+    @property
+    def kernel(self) -> kernel.RRContact:
+        """The kernel's rr_contact struct of this model (its arrays are pinned on the object)."""
+        if self._k is None:
+            arrays = [np.ascontiguousarray(a, dtype=float) for a in (
+                self.G, self.A, self.B, self.C, self.D, self._res_F, self._res_M, self._tq_F, self._tq_M,
+                self.geometry.disk)]
+            self._lib = kernel.load()
+            work = np.zeros(self._lib.rr_work_size(self.n_dofs, self.n_blades, self.n_points))
+            self._pinned = (*arrays, work)
+            self._k = kernel.RRContact(self.n_dofs, self.n_blades, self.n_points, float(self.g0), float(self.k_r),
+                                       float(self.mu), float(max(self.geometry.chord, 1e-300)),
+                                       *map(kernel.ptr, self._pinned))
+        return self._k
+
+    @property
+    def lib(self):
+        """The loaded kernel library (ctypes)."""
+        self.kernel  # noqa: B018 - loads it
+        return self._lib
+
+    def __getstate__(self) -> dict:
+        # ctypes objects do not pickle: a copy in another process builds its own view
+        state = {k: v for k, v in self.__dict__.items() if k not in ("_k", "_pinned", "_lib")}
+        state["_k"] = None
+        return state
 
     @property
     def n_dofs(self) -> int:
         return self.G.shape[1]
 
+    @property
+    def n_outputs(self) -> int:
+        """Number of outputs of a state (the kernel's layout, rotorub_kernel.h)."""
+        return kernel.OUT_BLADE_BLOCKS * self.n_blades + kernel.OUT_GLOBALS
+
     def with_clearance(self, g0: float) -> ContactModel:
         """Same geometry, another nominal clearance (cheap: gaps are affine)."""
         return ContactModel(self.formulation, self.variant, self.geometry, g0, self.k_r, self.mu)
 
+    def _eval(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        q = np.ascontiguousarray(q, dtype=float)
+        gaps = np.empty((self.n_blades, self.n_points))
+        law = np.empty((self.n_blades, kernel.LAW_WIDTH))
+        k = self.kernel
+        self._lib.rr_laws(k, kernel.ptr(q), kernel.ptr(gaps), kernel.ptr(law))
+        return gaps, law
+
     def gaps(self, q: np.ndarray) -> np.ndarray:
         """Gaps (N, P) [m]: tip (2D) or LE, TE (3D); negative = penetration."""
-        return (self.g0 + self.G @ q).reshape(self.n_blades, self.n_points)
+        return self._eval(q)[0]
 
     def laws(self, q: np.ndarray) -> np.ndarray:
         """Per blade (N, 7): F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction."""
-        out = np.zeros((self.n_blades, 7))
-        blade_laws(self.gaps(q), self.k_r, max(self.geometry.chord, 1e-300), self.n_points == 2, out)
-        return out
+        return self._eval(q)[1]
 
     def forces(self, q: np.ndarray) -> np.ndarray:
         """Generalised contact force vector F_nl(q) (on rotor and casing dofs)."""
-        L = self.laws(q)
-        return self._project(L[:, 0], L[:, 1])
-
-    def _project(self, FN: np.ndarray, MN: np.ndarray) -> np.ndarray:
-        return self.A.T @ FN + self.B.T @ MN - self.mu * (self.C.T @ FN + self.D.T @ MN)
+        q = np.ascontiguousarray(q, dtype=float)
+        f = np.empty(self.n_dofs)
+        k = self.kernel
+        self._lib.rr_force(k, kernel.ptr(q), kernel.ptr(f))
+        return f
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
         """Analytic d F_nl / d q (not symmetric when mu > 0)."""
-        L = self.laws(q)
-        dF = L[:, 2, None] * self.A + L[:, 3, None] * self.B  # d F_N / dq, (N, n)
-        dM = L[:, 4, None] * self.A + L[:, 5, None] * self.B  # d M_N / dq
-        return self.A.T @ dF + self.B.T @ dM - self.mu * (self.C.T @ dF + self.D.T @ dM)
+        q = np.ascontiguousarray(q, dtype=float)
+        J = np.empty((self.n_dofs, self.n_dofs))
+        k = self.kernel
+        self._lib.rr_jacobian(k, kernel.ptr(q), kernel.ptr(J))
+        return J
+
+    def gaps_batch(self, Q: np.ndarray) -> np.ndarray:
+        """Gaps of many states Q (m, n): (m, N, P)."""
+        Q = np.ascontiguousarray(Q, dtype=float)
+        out = np.empty((Q.shape[0], self.n_blades, self.n_points))
+        k = self.kernel
+        self._lib.rr_gaps_batch(k, int(Q.shape[0]), kernel.ptr(Q), kernel.ptr(out))
+        return out
 
     def blade_forces(self, q: np.ndarray) -> dict[str, np.ndarray]:
         """Per-blade outputs: F_N, F_T, M_N, M_T [N, N m], gaps, chord fraction in contact."""
-        L = self.laws(q)
-        g = self.gaps(q)
+        g, L = self._eval(q)
         return {
             "F_N": L[:, 0].copy(),
             "F_T": self.mu * L[:, 0],
@@ -146,20 +193,43 @@ class ContactModel:
             "fraction": L[:, 6].copy(),
         }
 
+    def outputs_array(self, Q: np.ndarray) -> np.ndarray:
+        """The kernel's outputs of states Q (m, n) or q (n), rotating frame: (m, n_outputs)."""
+        Q = np.ascontiguousarray(np.atleast_2d(Q), dtype=float)
+        out = np.empty((Q.shape[0], self.n_outputs))
+        k = self.kernel
+        self._lib.rr_outputs_batch(k, int(Q.shape[0]), kernel.ptr(Q), kernel.ptr(out))
+        return out
+
+    def split_outputs(self, out: np.ndarray) -> dict[str, np.ndarray]:
+        """Named views of kernel outputs (m, n_outputs): per-blade (m, N) blocks, gaps (m, N, P), globals (m,)."""
+        N = self.n_blades
+        b = {name: out[:, i * N:(i + 1) * N] for i, name in enumerate(kernel.OUT_BLADE_NAMES)}
+        at = kernel.OUT_BLADE_BLOCKS * N
+        gl = {name: out[:, at + i] for i, name in enumerate(kernel.OUT_GLOBAL_NAMES)}
+        gap = np.stack([b["gap_LE"], b["gap_TE"]], axis=-1) if self.n_points == 2 else b["gap_LE"][..., None]
+        return {
+            "F_N": b["F_N"], "F_T": b["F_T"], "fraction": b["contact_fraction"], "gap": gap, "gap_tip": b["gap_tip"],
+            "casing_force": np.stack([gl["casing_force.x"], gl["casing_force.y"], gl["casing_force.z"]], axis=-1),
+            "friction_torque": gl["friction_torque"],
+            "disk": np.stack([gl["disk_displacement.x"], gl["disk_displacement.y"]], axis=-1),
+            "gap_min": gl["gap_min"], "n_contact": gl["n_contact"].astype(int),
+        }
+
+    def write_outputs(self, q: np.ndarray, phi: float, index: np.ndarray, dest: np.ndarray) -> None:
+        """The outputs of state q, fixed frame at angle phi, written to dest[index[k]] (an FMU's
+        value buffer; ``index``: intc array in the kernel's order, ``dest``: float64)."""
+        q = np.ascontiguousarray(q, dtype=float)
+        k = self.kernel
+        self._lib.rr_outputs(k, kernel.ptr(q), float(phi), kernel.iptr(index), kernel.ptr(dest))
+
     def outputs(self, q: np.ndarray) -> dict[str, np.ndarray | float]:
         """Everything an output needs at one state, with the contact law evaluated once:
-        per blade F_N, F_T, M_N, gap (N, P), fraction; the casing resultant (rotating frame)
-        and the friction torque on the rotor (same values as :meth:`resultant_on_casing`
-        and :meth:`friction_torque_on_rotor`)."""
-        g = (self.g0 + self.G @ q).reshape(self.n_blades, self.n_points)
-        L = self._out
-        blade_laws(g, self.k_r, max(self.geometry.chord, 1e-300), self.n_points == 2, L)
-        FN, MN = L[:, 0].copy(), L[:, 1].copy()
-        return {
-            "F_N": FN, "F_T": self.mu * FN, "M_N": MN, "gap": g, "fraction": L[:, 6].copy(),
-            "casing_force": FN @ self._res_F + MN @ self._res_M,
-            "friction_torque": float(FN @ self._tq_F + MN @ self._tq_M),
-        }
+        per blade F_N, F_T, gap (N, P), fraction; the casing resultant (rotating frame),
+        the friction torque on the rotor (same values as :meth:`resultant_on_casing`
+        and :meth:`friction_torque_on_rotor`), the fan-disk displacement, the smallest gap."""
+        o = self.split_outputs(self.outputs_array(q))
+        return {k: float(v[0]) if v.ndim == 1 else v[0] for k, v in o.items()}
 
     def point_forces(self, q: np.ndarray) -> np.ndarray:
         """Physical forces on the blade at each contact point (N, P, 3), statically

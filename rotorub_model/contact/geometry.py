@@ -17,3 +17,4 @@ class ContactGeometry:
     Jb: np.ndarray  # (N, P, 3, n) blade-point displacement maps
     Jc: np.ndarray  # (N, P, 3, n) casing-point displacement maps
     chord: float  # l_c (0 for the point law)
+    disk: np.ndarray  # (2, n) fan-disk centre translation (rotating x, y): an output of every state

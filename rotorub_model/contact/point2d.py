@@ -38,4 +38,4 @@ def geometry_2d(model: Model) -> ContactGeometry:
         D = casing_point_map(p, pts[j, 0])
         D[:, 2:4] = 0.0  # no casing tilt in the 2D kinematics
         Jc[j, 0][:, cs] = D
-    return ContactGeometry(pts, nor, tan, Jb, Jc, 0.0)
+    return ContactGeometry(pts, nor, tan, Jb, Jc, 0.0, np.ascontiguousarray(T[:2]))

@@ -18,13 +18,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
+from pathlib import Path
 
 import numpy as np
 
 from .blades import bladed_disk_matrices
 from .casing import casing_matrices
 from .frames import MATRIX_KEYS, Matrices
-from .params import Parameters, reference_parameters
+from .params import Parameters, from_dict, reference_parameters, to_dict
 from .shaft import shaft_matrices, station_maps
 
 
@@ -139,3 +140,38 @@ def build_model(params: Parameters | None = None) -> Model:
     ft[slices["shaft"]] = Ts.T @ np.array([-np.sin(ang), np.cos(ang), 0.0])
     model.f_tangential = ft
     return model
+
+
+_ARRAYS = ("M", "D", "K", "G1", "C1", "N2", "S2", "E1", "f_unit", "f_tangential", "f_euler")
+
+
+def save_model(model: Model, path: str | Path) -> Path:
+    """Write the assembled model (matrices, dofs, parameters, disk maps) to an .npz file.
+
+    What a consumer that must not depend on scipy needs: :func:`load_model` restores the
+    same arrays bit for bit without assembling anything (the FMU carries one).
+    """
+    import json
+
+    T, R = model.disk_maps
+    path = Path(path)
+    np.savez(path, params=json.dumps(to_dict(model.params)), dofs=np.array(model.dofs),
+             slices=json.dumps({k: [s.start, s.stop] for k, s in model.slices.items()}),
+             disk_T=T, disk_R=R, **{k: getattr(model, k) for k in _ARRAYS})
+    return path
+
+
+def load_model(path: str | Path, params: Parameters | None = None) -> Model:
+    """The model saved by :func:`save_model`. ``params`` may replace the parameters when only
+    sections that do not enter the matrices differ (``contact``: clearance, k_r, mu, cone, chord)."""
+    import json
+
+    with np.load(Path(path), allow_pickle=False) as d:
+        saved = from_dict(json.loads(str(d["params"])))
+        if params is not None and params.replace(contact=to_dict(saved)["contact"]) != saved:
+            raise ValueError("load_model: the parameters differ from the saved model's outside [contact]")
+        m = Model(params=params or saved, dofs=[str(x) for x in d["dofs"]],
+                  slices={k: slice(a, b) for k, (a, b) in json.loads(str(d["slices"])).items()},
+                  **{k: np.array(d[k]) for k in _ARRAYS})
+        m.__dict__["disk_maps"] = (np.array(d["disk_T"]), np.array(d["disk_R"]))
+    return m

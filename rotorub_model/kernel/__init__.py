@@ -1,0 +1,180 @@
+"""The compiled kernel (``rotorub_kernel.c``): loading it, and typed handles on its structs.
+
+The shared library is found, in this order:
+
+1. ``$ROTORUB_KERNEL``: an explicit path (a binary built elsewhere);
+2. ``bin/<machine>-<os>/`` next to this file: a binary shipped with a copy of the package
+   (the FMU carries one), used when its source id matches the sources here;
+3. the user cache (``$ROTORUB_CACHE_DIR``, else ``$XDG_CACHE_HOME/rotorub``, else
+   ``~/.cache/rotorub``): ``kernel-<source id>-<machine>-<os>.so``;
+4. otherwise it is compiled once into that cache (see :mod:`.compiler`), which takes a
+   second with the system compiler and a few with ziglang.
+
+The source id is a hash of the C sources, so an edited kernel is rebuilt and two versions
+of the library never load each other's binary.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import os
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from .compiler import CompilerError, compile_shared, host_platform_tag, host_suffix
+
+HERE = Path(__file__).resolve().parent
+SOURCES = (HERE / "rotorub_kernel.c",)
+HEADER = HERE / "rotorub_kernel.h"
+ABI_VERSION = 1
+LAW_WIDTH = 7
+OUT_BLADE_BLOCKS = 6
+OUT_GLOBALS = 8
+# names of the per-blade output blocks and of the globals, in the kernel's order (rotorub_kernel.h)
+OUT_BLADE_NAMES = ("F_N", "F_T", "gap_LE", "gap_TE", "gap_tip", "contact_fraction")
+OUT_GLOBAL_NAMES = ("casing_force.x", "casing_force.y", "casing_force.z", "friction_torque",
+                    "disk_displacement.x", "disk_displacement.y", "gap_min", "n_contact")
+
+_dp = ctypes.POINTER(ctypes.c_double)
+_ip = ctypes.POINTER(ctypes.c_int)
+
+
+class RRContact(ctypes.Structure):
+    _fields_ = [("n", ctypes.c_int), ("nb", ctypes.c_int), ("np", ctypes.c_int), ("g0", ctypes.c_double),
+                ("k_r", ctypes.c_double), ("mu", ctypes.c_double), ("chord", ctypes.c_double),
+                ("G", _dp), ("A", _dp), ("B", _dp), ("C", _dp), ("D", _dp), ("res_F", _dp), ("res_M", _dp),
+                ("tq_F", _dp), ("tq_M", _dp), ("T2", _dp), ("work", _dp)]
+
+
+class RRMatrices(ctypes.Structure):
+    _fields_ = [("n", ctypes.c_int), ("Ainv", _dp), ("K2", _dp), ("Cm1", _dp), ("f", _dp)]
+
+
+class RRState(ctypes.Structure):
+    _fields_ = [("t", ctypes.c_double), ("dt", ctypes.c_double), ("phi", ctypes.c_double),
+                ("max_pen", ctypes.c_double), ("steps", ctypes.c_longlong), ("diverged", ctypes.c_int),
+                ("q", _dp), ("q_prev", _dp)]
+
+
+def source_id() -> str:
+    h = hashlib.sha256()
+    for p in (*SOURCES, HEADER):
+        h.update(p.name.encode())
+        h.update(p.read_bytes().replace(b"\r\n", b"\n"))
+    return h.hexdigest()[:16]
+
+
+def cache_dir() -> Path:
+    if os.environ.get("ROTORUB_CACHE_DIR"):
+        return Path(os.environ["ROTORUB_CACHE_DIR"])
+    base = os.environ.get("XDG_CACHE_HOME") or (Path.home() / ".cache")
+    return Path(base) / "rotorub"
+
+
+def shipped_binary(tag: str | None = None) -> Path:
+    """Where a copy of the package carries a prebuilt kernel for platform ``tag``."""
+    tag = tag or host_platform_tag()
+    suffix = ".dll" if tag.endswith("windows") or tag.endswith("win") else host_suffix()
+    return HERE / "bin" / tag / f"rotorub_kernel{suffix}"
+
+
+def build(out: Path, target: str | None = None) -> Path:
+    """Compile the kernel into ``out`` (``target``: an FMI platform folder, for a cross build)."""
+    return compile_shared(list(SOURCES), out, target=target, defines={"RR_SOURCE_ID": f'"{source_id()}"'},
+                          include=[HERE])
+
+
+def _declare(lib: ctypes.CDLL) -> ctypes.CDLL:
+    c = ctypes.POINTER(RRContact)
+    lib.rr_abi_version.restype = ctypes.c_int
+    lib.rr_source_id.restype = ctypes.c_char_p
+    lib.rr_work_size.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_int]
+    lib.rr_work_size.restype = ctypes.c_int
+    lib.rr_blade_law.argtypes = [ctypes.c_int, ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_double,
+                                 _dp]
+    lib.rr_laws.argtypes = [c, _dp, _dp, _dp]
+    lib.rr_force.argtypes = [c, _dp, _dp]
+    lib.rr_jacobian.argtypes = [c, _dp, _dp]
+    lib.rr_gaps_batch.argtypes = [c, ctypes.c_int, _dp, _dp]
+    lib.rr_outputs.argtypes = [c, _dp, ctypes.c_double, _ip, _dp]
+    lib.rr_outputs_batch.argtypes = [c, ctypes.c_int, _dp, _dp]
+    lib.rr_cd_advance.argtypes = [ctypes.POINTER(RRState), c, ctypes.POINTER(RRMatrices), ctypes.c_int,
+                                  ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_int, ctypes.c_int,
+                                  _dp, _dp, _ip, _ip, _dp]
+    lib.rr_cd_advance.restype = ctypes.c_int
+    for name in ("rr_blade_law", "rr_laws", "rr_force", "rr_jacobian", "rr_gaps_batch", "rr_outputs",
+                 "rr_outputs_batch"):
+        getattr(lib, name).restype = None
+    return lib
+
+
+def _open(path: Path, expect_id: str | None) -> ctypes.CDLL | None:
+    try:
+        lib = ctypes.CDLL(str(path))
+    except OSError:
+        return None
+    lib.rr_abi_version.restype = ctypes.c_int
+    lib.rr_source_id.restype = ctypes.c_char_p
+    if lib.rr_abi_version() != ABI_VERSION:
+        return None
+    if expect_id is not None and lib.rr_source_id().decode() != expect_id:
+        return None
+    return _declare(lib)
+
+
+@lru_cache(maxsize=1)
+def load() -> ctypes.CDLL:
+    """The kernel library of this process (built into the user cache on first use)."""
+    sid = source_id()
+    explicit = os.environ.get("ROTORUB_KERNEL")
+    if explicit:
+        lib = _open(Path(explicit), None)
+        if lib is None:
+            raise CompilerError(f"ROTORUB_KERNEL={explicit}: not a loadable rotorub kernel of ABI {ABI_VERSION}")
+        return lib
+    shipped = shipped_binary()
+    if shipped.exists():
+        lib = _open(shipped, sid)
+        if lib is not None:
+            return lib
+    cached = cache_dir() / f"kernel-{sid}-{host_platform_tag()}{host_suffix()}"
+    if cached.exists():
+        lib = _open(cached, sid)
+        if lib is not None:
+            return lib
+    build(cached)
+    lib = _open(cached, sid)
+    if lib is None:
+        raise CompilerError(f"the kernel built at {cached} cannot be loaded")
+    return lib
+
+
+def chord_law(g_le: float, g_te: float, k: float, l: float) -> tuple[float, ...]:
+    """The kernel's chord law of one blade: (F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, fraction)."""
+    out = (ctypes.c_double * LAW_WIDTH)()
+    load().rr_blade_law(2, float(g_le), float(g_te), float(k), float(l), out)
+    return tuple(out)
+
+
+def point_law(g: float, k: float) -> tuple[float, float]:
+    """The kernel's point law: (F_N, dF/dg)."""
+    out = (ctypes.c_double * LAW_WIDTH)()
+    load().rr_blade_law(1, float(g), 0.0, float(k), 1.0, out)
+    return out[0], out[2]
+
+
+def ptr(a: np.ndarray):
+    """A double* on a C-contiguous float64 array (the array must outlive its use)."""
+    return a.ctypes.data_as(_dp)
+
+
+def iptr(a: np.ndarray):
+    return a.ctypes.data_as(_ip)
+
+
+__all__ = ["ABI_VERSION", "CompilerError", "LAW_WIDTH", "OUT_BLADE_NAMES", "OUT_GLOBAL_NAMES", "RRContact",
+           "RRMatrices", "RRState", "build", "cache_dir", "chord_law", "iptr", "load", "point_law", "ptr",
+           "source_id"]

@@ -1,0 +1,151 @@
+/*
+ * rotorub kernel: the hot path of the blade-tip / casing contact model in portable C99
+ * (libm only). One source, used by the Python library (through ctypes), by the pythonfmu
+ * FMU (a prebuilt copy in its resources) and by the native FMI 2.0 FMU.
+ *
+ * What it holds:
+ *   - the contact laws: 2D point law and 3D chord law (eq. 5-8 of Parent, Thouverez &
+ *     Chevillot 2014) with Coulomb friction, their projection on the generalised
+ *     coordinates and the Jacobian the static and stability solvers use;
+ *   - the outputs of a state (per-blade forces, gaps, chord fraction; casing resultant,
+ *     friction torque, fan-disk displacement, smallest gap, blades in contact);
+ *   - the explicit central-difference substep loop on dense matrices.
+ *
+ * What it does not hold: the structure's matrices and the contact geometry (gap
+ * gradients, projection rows), which the caller builds once and passes by pointer.
+ * Matrices are dense, row-major, double precision. Nothing here allocates memory.
+ *
+ * Conventions (docs/THEORY.md): SI units; gaps positive when open; F_N >= 0 is the
+ * magnitude of the normal force; friction F_T = mu F_N opposes the spin.
+ *
+ * Floating-point: the arithmetic is written in a fixed order and must be compiled
+ * without contraction to FMA or reassociation (-ffp-contract=off, no -ffast-math), so
+ * that every platform and both FMUs give the same numbers as the library.
+ */
+#ifndef ROTORUB_KERNEL_H
+#define ROTORUB_KERNEL_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(_WIN32)
+#  if defined(RR_BUILD_SHARED)
+#    define RR_API __declspec(dllexport)
+#  else
+#    define RR_API
+#  endif
+#elif defined(__GNUC__)
+#  define RR_API __attribute__((visibility("default")))
+#else
+#  define RR_API
+#endif
+
+/* Bumped whenever a struct layout or a signature below changes. */
+#define RR_ABI_VERSION 1
+
+/* Per-blade law values (rr_laws): F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction. */
+#define RR_LAW_WIDTH 7
+
+/* Layout of the outputs of a state (rr_outputs): six per-blade blocks, then globals. */
+enum {
+    RR_OUT_FN = 0,       /* normal force per blade [N] */
+    RR_OUT_FT = 1,       /* friction force per blade, mu F_N [N] */
+    RR_OUT_GAP_LE = 2,   /* gap at the leading edge (2D: the tip gap) [m] */
+    RR_OUT_GAP_TE = 3,   /* gap at the trailing edge (2D: the tip gap) [m] */
+    RR_OUT_GAP_TIP = 4,  /* smallest gap of the blade [m] */
+    RR_OUT_FRACTION = 5, /* chord fraction in contact (2D: 0 or 1) */
+    RR_OUT_BLADE_BLOCKS = 6
+};
+enum {
+    RR_OUT_CASING_X = 0, RR_OUT_CASING_Y, RR_OUT_CASING_Z, /* resultant on the casing [N] */
+    RR_OUT_TORQUE,                                          /* axial torque on the rotor [N m] */
+    RR_OUT_DISK_X, RR_OUT_DISK_Y,                           /* fan-disk centre [m] */
+    RR_OUT_GAP_MIN,                                         /* smallest gap [m] */
+    RR_OUT_N_CONTACT,                                       /* blades with F_N > 0 */
+    RR_OUT_GLOBALS
+};
+/* number of outputs of a state for nb blades */
+#define RR_N_OUT(nb) (RR_OUT_BLADE_BLOCKS * (nb) + RR_OUT_GLOBALS)
+
+/* Contact geometry and law parameters of one formulation (all arrays owned by the caller). */
+typedef struct {
+    int n;            /* generalised coordinates */
+    int nb;           /* blades */
+    int np;           /* contact points per blade: 1 (2D tip) or 2 (3D leading, trailing edge) */
+    double g0;        /* nominal clearance [m] */
+    double k_r;       /* normal stiffness of a whole blade tip [N/m] */
+    double mu;        /* Coulomb friction coefficient */
+    double chord;     /* chord length l_c [m] (any positive value for np = 1) */
+    const double *G;  /* (nb*np, n) gap gradients: gap = g0 + G q */
+    const double *A;  /* (nb, n) d eta / dq   (mean gap along the chord) */
+    const double *B;  /* (nb, n) d zeta / dq  (gap slope along the chord) */
+    const double *C;  /* (nb, n) d t_mid / dq (sliding displacement, mean) */
+    const double *D;  /* (nb, n) d t_slope / dq */
+    const double *res_F; /* (nb, 3) casing resultant per unit F_N (rotating frame) */
+    const double *res_M; /* (nb, 3) casing resultant per unit M_N */
+    const double *tq_F;  /* (nb) torque on the rotor per unit F_N */
+    const double *tq_M;  /* (nb) torque on the rotor per unit M_N */
+    const double *T2;    /* (2, n) fan-disk translation (rotating frame) */
+    double *work;        /* scratch of at least rr_work_size(n, nb, np) doubles */
+} rr_contact;
+
+/* Central-difference matrices at one (Omega, dt): (M/dt^2 + C/2dt)^-1, 2M/dt^2 - K, M/dt^2 - C/2dt. */
+typedef struct {
+    int n;
+    const double *Ainv;  /* (n, n) */
+    const double *K2;    /* (n, n) */
+    const double *Cm1;   /* (n, n) */
+    const double *f;     /* (n) imbalance force at the full m e */
+} rr_cd_matrices;
+
+/* State of the two-step scheme. q and q_prev are owned by the caller. */
+typedef struct {
+    double t;          /* time of q [s] */
+    double dt;         /* step [s] */
+    double phi;        /* angle of the rotating frame [rad] */
+    double max_pen;    /* divergence: a gap below -max_pen [m] */
+    long long steps;   /* steps taken since the start */
+    int diverged;      /* set when a gap fell below -max_pen or a value stopped being finite */
+    double *q;         /* (n) displacements at t */
+    double *q_prev;    /* (n) displacements at t - dt */
+} rr_cd_state;
+
+RR_API int rr_abi_version(void);
+RR_API const char *rr_source_id(void);
+/* doubles of scratch an rr_contact needs in its work pointer */
+RR_API int rr_work_size(int n, int nb, int np);
+
+/* The law of one blade from its gaps: np = 2 chord law (g_le, g_te), np = 1 point law (g_le). */
+RR_API void rr_blade_law(int np, double g_le, double g_te, double k, double l, double *out);
+/* Gaps (nb*np) and per-blade law values (nb x RR_LAW_WIDTH) at q. */
+RR_API void rr_laws(const rr_contact *c, const double *q, double *gaps, double *law);
+/* Generalised contact force F_nl(q) (n). */
+RR_API void rr_force(const rr_contact *c, const double *q, double *f);
+/* Jacobian dF_nl/dq (n x n, row-major; not symmetric when mu > 0). */
+RR_API void rr_jacobian(const rr_contact *c, const double *q, double *J);
+/* Gaps of m states Q (m x n) into gaps (m x nb*np). */
+RR_API void rr_gaps_batch(const rr_contact *c, int m, const double *Q, double *gaps);
+
+/* The RR_N_OUT(nb) outputs of state q, casing force and disk displacement rotated by phi
+ * (phi = 0: rotating frame). If index is NULL they are written to dest[0..], else
+ * dest[index[k]] = output k (straight into an FMU's value buffer). */
+RR_API void rr_outputs(const rr_contact *c, const double *q, double phi, const int *index, double *dest);
+/* Outputs of m states (m x n) in the rotating frame, into out (m x RR_N_OUT(nb)). */
+RR_API void rr_outputs_batch(const rr_contact *c, int m, const double *Q, double *out);
+
+/* Advance n_steps central-difference steps at constant matrices. The imbalance force is
+ * f * me * r(t), r = min(t / t_ramp, 1) (t_ramp <= 0: r = 1). Every rec_every-th step (counted
+ * from the start of the run, s->steps) the new q and its rotating-frame outputs are written to
+ * rec_q[*n_rec] and rec_out[*n_rec] while *n_rec < rec_cap (rec_cap = 0: no records).
+ * omega [rad/s] advances the frame angle. If out_dest is not NULL the outputs of the final
+ * state, rotated by the final phi, are written there through out_index (see rr_outputs).
+ * Returns the steps done (fewer than n_steps if the run diverged: s->diverged is then set). */
+RR_API int rr_cd_advance(rr_cd_state *s, const rr_contact *c, const rr_cd_matrices *m, int n_steps,
+                         double omega, double me, double t_ramp, int rec_every, int rec_cap,
+                         double *rec_q, double *rec_out, int *n_rec, const int *out_index, double *out_dest);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
