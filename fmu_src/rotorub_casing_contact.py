@@ -106,6 +106,7 @@ class RotorCasingContact(Fmi2Slave):
         self._is_real = np.array([k == "Real" for k in self._kind])
         self._is_int = np.array([k == "Integer" for k in self._kind])
         self._settable = np.array([s[2] in ("input", "parameter") for s in self._specs])
+        self._real_inputs = frozenset(self._slot[k] for k in ("Omega", "imbalance", "g0"))
         starts = {
             "Omega": 0.0, "imbalance": ref.imbalance.me, "g0": c.g0, "k_r": c.k_r, "mu": c.mu,
             "theta": math.radians(c.theta_deg), "chord": c.chord, "dt_max": 1e-3,
@@ -127,6 +128,9 @@ class RotorCasingContact(Fmi2Slave):
                                     for j in range(nb)] + [self._slot[g] for g in kern.OUT_GLOBAL_NAMES],
                                    dtype=np.intc)
         self._n_contact_slot = self._slot["n_contact"]
+        self._i_omega, self._i_me, self._i_g0 = self._slot["Omega"], self._slot["imbalance"], self._slot["g0"]
+        self._i_dt, self._i_nsub = self._slot["dt_internal"], self._slot["n_substeps"]
+        self._get_memo: tuple[list, np.ndarray] = ([], np.zeros(0, dtype=np.intp))
         self._phase = "instantiated"  # -> initialization -> step
         self._t = 0.0  # current communication point
         self._sim = None  # runtime objects, built at the end of initialization
@@ -236,10 +240,13 @@ class RotorCasingContact(Fmi2Slave):
 
     # fast paths for the per-step traffic (same semantics as pythonfmu's)
     def get_real(self, vrs):
-        idx = np.asarray(vrs, dtype=np.intp)
-        if not self._is_real[idx].all():
-            raise TypeError(f"get_real: value reference(s) {idx[~self._is_real[idx]].tolist()} are not Real")
-        return self._rv[idx].tolist()
+        memo_vrs, idx = self._get_memo
+        if vrs != memo_vrs:  # a master reads the same list every step: check and convert it once
+            idx = np.asarray(vrs, dtype=np.intp)
+            if not self._is_real[idx].all():
+                raise TypeError(f"get_real: value reference(s) {idx[~self._is_real[idx]].tolist()} are not Real")
+            self._get_memo = (list(vrs), idx)
+        return self._rv.take(idx).tolist()
 
     def get_integer(self, vrs):
         idx = np.asarray(vrs, dtype=np.intp)
@@ -248,11 +255,14 @@ class RotorCasingContact(Fmi2Slave):
         return self._iv[idx].tolist()
 
     def set_real(self, vrs, values):
+        rv, inputs = self._rv, self._real_inputs
         for vr, v in zip(vrs, values):
-            if self._kind[vr] != "Real":
+            if vr in inputs:  # the per-step traffic: Omega, imbalance, g0 (tunable)
+                rv[vr] = v
+            elif self._kind[vr] != "Real":
                 self.log(f"set_real: value reference {vr} is not Real; ignored", Fmi2Status.error)
-                continue
-            self._set_value(vr, float(v))
+            else:
+                self._set_value(vr, float(v))
 
     def _r(self, name: str) -> float:
         return float(self._rv[self._slot[name]])
@@ -356,16 +366,22 @@ class RotorCasingContact(Fmi2Slave):
         params = params.replace(contact={"g0": g0, "k_r": cfg["k_r"], "mu": cfg["mu"],
                                          "theta_deg": math.degrees(cfg["theta"]), "chord": cfg["chord"]})
         if path:
-            model = lib.model.build_model(params)  # assembling a model needs scipy (component modes)
+            try:  # assembling a model needs scipy (the shaft's component modes)
+                model = lib.model.build_model(params)
+            except ModuleNotFoundError as exc:
+                raise ValueError(f"param_file '{path}': assembling a model needs {exc.name} (pip install "
+                                 f"{exc.name}); the model built into the FMU (empty param_file) needs only numpy") \
+                    from None
         else:  # the matrices baked at build time: no assembly, numpy only
             model = lib.model.load_model(self._resources / self._manifest["model"], params)
         contact = lib.contact.make_contact(model, cfg["formulation"])
         sim = {"config": cfg, "model": model, "contact": contact, "g0": g0, "phi": 0.0, "q_static": None,
-               "limit": (None, None)}
+               "limit": (None, None), "plan": (None, None, 0), "transient": cfg["mode"] == "transient"}
         if cfg["mode"] == "transient":
             omega0 = self._r("Omega")
             w = omega0 if math.isfinite(omega0) and omega0 >= 0 else 0.0
             sim["cd"] = lib.transient.CentralDifference(model, contact, dt=None, t_ramp=0.0, omega_max_for_dt=w)
+            sim["cd"].bind_outputs(self._out_index, self._rv)
             q = sim["cd"].q
         else:
             q = np.zeros(model.n_dofs)
@@ -381,7 +397,8 @@ class RotorCasingContact(Fmi2Slave):
 
     # ------------------------------------------------------------------ stepping
     def _check_inputs(self) -> str | None:
-        om, me, g0 = self._r("Omega"), self._r("imbalance"), self._r("g0")
+        rv = self._rv
+        om, me, g0 = float(rv[self._i_omega]), float(rv[self._i_me]), float(rv[self._i_g0])
         if not math.isfinite(om) or om < 0:
             return f"Omega: {om!r} rad/s is not a valid spin speed; accepted range [0, inf) rad/s (finite)"
         if not math.isfinite(me) or me < 0:
@@ -407,11 +424,12 @@ class RotorCasingContact(Fmi2Slave):
             self._report(STATUS_ERROR, f"at t = {t:g} s: {err}; step refused, state unchanged")
             return False
         sim = self._sim
-        omega, me, g0 = self._r("Omega"), self._r("imbalance"), self._r("g0")
+        rv = self._rv
+        omega, me, g0 = float(rv[self._i_omega]), float(rv[self._i_me]), float(rv[self._i_g0])
         if g0 != sim["g0"]:
             sim["g0"] = g0
             self._apply_clearance(g0)
-        if sim["config"]["mode"] == "transient":
+        if sim["transient"]:
             ok = self._transient(omega, me, h)
         else:
             ok, msg = self._quasi_static(omega, me, h)
@@ -433,42 +451,40 @@ class RotorCasingContact(Fmi2Slave):
         else:
             sim["contact"] = sim["contact"].with_clearance(g0)
 
-    def _stability_cap(self, omega: float) -> float:
-        """Half the central-difference stability limit (the library's default step), evaluated at omega
-        rounded up to a whole rad/s: an eigen-solve per band instead of per step in a run-up (the limit
-        moves by far less than the factor 1/2 kept in hand across 1 rad/s)."""
+    def _substeps(self, omega: float, h: float) -> int:
+        """n = ceil(h / cap), cap = min(dt_max, half the central-difference stability limit at omega
+        rounded up to a whole rad/s): the internal step h/n depends only on dt_max, the limit and
+        h, never on earlier steps. The limit is evaluated once per 1 rad/s band (an eigen-solve per
+        band, not per step, in a run-up: it moves by far less than the factor 1/2 kept in hand)."""
         sim = self._sim
-        band = float(math.ceil(omega))
-        w, lim = sim["limit"]
-        if w != band:
-            lim = self._lib.transient.critical_time_step(sim["model"], sim["contact"], band)
-            sim["limit"] = (band, lim)
-        return 0.5 * lim
+        band = math.ceil(omega)
+        if sim["plan"][:2] != (h, band):
+            w, lim = sim["limit"]
+            if w != band:
+                lim = self._lib.transient.critical_time_step(sim["model"], sim["contact"], float(band))
+                sim["limit"] = (band, lim)
+            cap = min(sim["config"]["dt_max"], 0.5 * lim)
+            sim["plan"] = (h, band, max(1, math.ceil(h / cap * (1 - 1e-9))))
+        return sim["plan"][2]
 
     def _transient(self, omega: float, me: float, h: float) -> bool:
-        sim = self._sim
-        cd = sim["cd"]
+        cd = self._sim["cd"]
         if cd.diverged:
             self._report(STATUS_DIVERGED, f"the run diverged at t = {cd.t:.6g} s (internal time); roll back "
                          "with fmi2SetFMUstate or reset the FMU")
             return False
-        cap = min(sim["config"]["dt_max"], self._stability_cap(omega))
-        # keep the current step if it divides h (within round-off of the master's time arithmetic)
-        n_cur = round(h / cd.dt)
-        if n_cur >= 1 and abs(n_cur * cd.dt - h) <= 1e-9 * h and cd.dt <= cap * (1 + 1e-9):
-            n = n_cur
-        else:
-            n = max(1, math.ceil(h / cap * (1 - 1e-9)))
-            dt_new = h / n
-            if dt_new != cd.dt:  # restart the two-step scheme at the same velocity
-                v = cd.velocity()
-                cd.dt = dt_new
-                cd.q_prev[:] = cd.q - dt_new * v
-        done, _ = cd.advance(n, omega, me, out_index=self._out_index, out_dest=self._rv)
-        self._iv[self._n_contact_slot] = int(self._rv[self._n_contact_slot])
-        self._rv[self._slot["dt_internal"]] = cd.dt
-        self._iv[self._slot["n_substeps"]] = done
-        if cd.diverged or done < n:
+        n = self._substeps(omega, h)
+        dt = h / n
+        if dt != cd.dt:  # restart the two-step scheme at the same velocity
+            v = cd.velocity()
+            cd.dt = dt
+            cd.q_prev[:] = cd.q - dt * v
+        done, _ = cd.advance(n, omega, me)  # the kernel writes the outputs into self._rv (bind_outputs)
+        rv = self._rv
+        self._iv[self._n_contact_slot] = rv[self._n_contact_slot]
+        rv[self._i_dt] = dt
+        self._iv[self._i_nsub] = done
+        if done < n:
             pen = cd.max_penetration
             self._report(STATUS_DIVERGED, f"the run diverged at t = {cd.t:.6g} s (internal time): a gap fell "
                          f"below -{pen * 1e3:g} mm (blade through the casing liner, penalty contact meaningless) "

@@ -245,3 +245,67 @@ def test_divergence_is_reported_and_rollback_recovers(fmu, unzipped):
         s.set_state(good)  # ... until rolled back
         s.step(None, 1e-3)
         assert s.get("status") == 0 and math.isfinite(s.get("gap_min"))
+
+
+NUMPY_ONLY_HOST = r'''
+import importlib.abc, json, sys
+
+class Block(importlib.abc.MetaPathFinder):
+    """What a bare host lacks: any import of these fails, as if they were not installed."""
+    BLOCKED = ("scipy", "numba", "llvmlite", "matplotlib", "rotorub_model", "tqdm", "dask")
+
+    def find_spec(self, name, path=None, target=None):
+        if name.split(".")[0] in self.BLOCKED:
+            raise ModuleNotFoundError(f"No module named '{name}'", name=name.split(".")[0])
+        return None
+
+sys.meta_path.insert(0, Block())
+from fmpy import simulate_fmu
+
+out = {}
+for mode in ("transient", "quasi_static"):
+    r = simulate_fmu(sys.argv[1], stop_time=0.02, output_interval=1e-3,
+                     start_values={"g0": 0.2e-3, "Omega": 176.2, "imbalance": 0.022, "mode": mode})
+    out[mode] = [float(r["blade[1].F_N"][-1]), int(r["status"][-1]), len(r)]
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+unzip = extract(sys.argv[1])
+md = read_model_description(unzip)
+vr = {v.name: v.valueReference for v in md.modelVariables}
+f = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier=md.coSimulation.modelIdentifier, instanceName="p")
+f.instantiate()
+f.setupExperiment(startTime=0.0)
+f.enterInitializationMode()
+f.setString([vr["param_file"]], [sys.argv[2]])
+f.exitInitializationMode()
+try:
+    f.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-3)
+    refused = False
+except Exception:
+    refused = True
+out["param_file"] = [f.getString([vr["message"]])[0].decode(), f.getInteger([vr["status"]])[0], refused]
+f.terminate()
+f.freeInstance()
+print(json.dumps(out))
+'''
+
+
+def test_a_python_with_numpy_only_runs_the_fmu(fmu, ref_model, tmp_path):
+    """No scipy, numba, matplotlib, rotorub in the host: both modes run on the built-in model; a
+    param_file, which needs scipy to assemble a model, is refused with a message that says so."""
+    import json
+    import subprocess
+    import sys
+
+    from rotorub_model.structure.params import REFERENCE_FILE
+
+    script = tmp_path / "host.py"
+    script.write_text(NUMPY_ONLY_HOST)
+    r = subprocess.run([sys.executable, str(script), fmu, str(REFERENCE_FILE)], capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, r.stderr[-3000:]
+    out = json.loads(r.stdout.strip().splitlines()[-1])
+    assert out["transient"][1] == 0 and out["transient"][2] == 21
+    assert out["quasi_static"][1] == 0 and out["quasi_static"][0] > 0  # 3D, 0.2 mm at 3.3: blade 1 touches
+    msg, status, refused = out["param_file"]
+    assert refused and status == 2 and "needs scipy" in msg and "pip install scipy" in msg, msg

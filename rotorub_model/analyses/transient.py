@@ -77,8 +77,7 @@ class CentralDifference:
             raise ParameterError(f"t_ramp: {t_ramp} out of range; accepted range [0, inf) s")
         if not math.isfinite(max_penetration) or max_penetration <= 0:
             raise ParameterError(f"max_penetration: {max_penetration} out of range; accepted range (0, inf) m")
-        self.model, self.contact = model, contact
-        self.t_ramp = float(t_ramp)
+        self.model = model
         self.user_dt = dt
         w = omega_max_for_dt if omega_max_for_dt is not None else 0.0
         self.dt_limit = critical_time_step(model, contact, w)
@@ -87,9 +86,14 @@ class CentralDifference:
         self.q_prev = np.zeros(n)
         self._s = kernel.RRState(0.0, self._check_dt(dt, self.dt_limit), 0.0, float(max_penetration), 0, 0,
                                  kernel.ptr(self.q), kernel.ptr(self.q_prev))
+        # one kernel job, kept: a call only changes what differs from the last one
+        self._job = kernel.RRJob(state=ctypes.addressof(self._s), t_ramp=float(t_ramp))
+        self._job_ref = ctypes.byref(self._job)
+        self._bound: tuple = ()
+        self._addresses: dict[int, tuple[np.ndarray, int]] = {}
         self._key = None
         self._mats = None
-        self._no_rec = np.empty((0, n))
+        self.contact = contact
 
     # the scheme's scalars live in the kernel's state struct
     t = property(lambda self: self._s.t, lambda self, v: setattr(self._s, "t", float(v)))
@@ -98,6 +102,17 @@ class CentralDifference:
     steps = property(lambda self: self._s.steps, lambda self, v: setattr(self._s, "steps", int(v)))
     diverged = property(lambda self: bool(self._s.diverged), lambda self, v: setattr(self._s, "diverged", int(v)))
     max_penetration = property(lambda self: self._s.max_pen)
+    t_ramp = property(lambda self: self._job.t_ramp)
+
+    @property
+    def contact(self) -> ContactModel:
+        return self._contact
+
+    @contact.setter
+    def contact(self, c: ContactModel) -> None:
+        self._contact = c
+        self._run = c.lib.rr_cd_run
+        self._job.contact = ctypes.addressof(c.kernel)
 
     @staticmethod
     def _check_dt(dt: float | None, limit: float) -> float:
@@ -128,7 +143,9 @@ class CentralDifference:
             arrays = (np.linalg.inv(Aeff), 2 * m.M / dt**2 - K, m.M / dt**2 - C / (2 * dt),
                       np.ascontiguousarray(m.force(omega, 1.0, omega_dot)))
             arrays = tuple(np.ascontiguousarray(a, dtype=float) for a in arrays)
-            self._mats = (kernel.RRMatrices(m.n_dofs, *map(kernel.ptr, arrays)), arrays)
+            mats = kernel.RRMatrices(m.n_dofs, *map(kernel.ptr, arrays))
+            self._mats = (mats, arrays)
+            self._job.mats = ctypes.addressof(mats)
             self._key = key
         return self._mats[0]
 
@@ -142,30 +159,52 @@ class CentralDifference:
             self._check_dt(self.user_dt, limit)
         self.dt_limit = min(self.dt_limit, limit)
 
+    def bind_outputs(self, index: np.ndarray | None, dest: np.ndarray | None) -> None:
+        """After every :meth:`advance`, write the outputs of the final state (fixed frame, the
+        kernel's layout) to ``dest[index[k]]``: an FMU's value buffer. None unbinds."""
+        self._bound = () if dest is None else (index, dest)  # keeps them alive while bound
+        self._job.out_index = None if dest is None else kernel.iptr(index)
+        self._job.out_dest = None if dest is None else kernel.ptr(dest)
+
     def advance(self, n_steps: int, omega: float, me: float, omega_dot: float = 0.0,
                 rec_every: int = 0, rec_q: np.ndarray | None = None, rec_start: int = 0,
-                rec_out: np.ndarray | None = None, out_index: np.ndarray | None = None,
-                out_dest: np.ndarray | None = None) -> tuple[int, int]:
+                rec_out: np.ndarray | None = None) -> tuple[int, int]:
         """Advance n_steps at constant inputs in one kernel call; returns (steps done, records written).
 
         Records: every ``rec_every``-th step of the run, q into ``rec_q`` and (if given) the
         outputs of the state (rotating frame, kernel layout) into ``rec_out``, from row
-        ``rec_start``. ``out_dest``: the outputs of the final state, fixed frame, written
-        through ``out_index`` (an FMU's value buffer).
+        ``rec_start``.
         """
         if self._s.diverged:
             return 0, rec_start
-        mats = self._matrices(omega, omega_dot)
+        if (omega, omega_dot, self._s.dt) != self._key:
+            self._matrices(omega, omega_dot)
+        job = self._job
+        job.n_steps = n_steps
+        job.omega = omega
+        job.me = me
         if rec_q is None:
-            rec_q, rec_every = self._no_rec, max(n_steps, 1)
-        n_rec = ctypes.c_int(rec_start)
-        c = self.contact
-        done = c.lib.rr_cd_advance(
-            ctypes.byref(self._s), c.kernel, ctypes.byref(mats), int(n_steps), float(omega), float(me),
-            self.t_ramp, int(max(rec_every, 1)), int(rec_q.shape[0]), kernel.ptr(rec_q),
-            None if rec_out is None else kernel.ptr(rec_out), ctypes.byref(n_rec),
-            None if out_index is None else kernel.iptr(out_index), None if out_dest is None else kernel.ptr(out_dest))
-        return done, n_rec.value
+            job.rec_cap = 0
+            job.n_rec = rec_start
+        else:
+            addr = self._address
+            job.rec_every = rec_every
+            job.rec_cap = rec_q.shape[0]
+            job.n_rec = rec_start
+            job.rec_q = addr(rec_q)
+            job.rec_out = addr(rec_out)
+        return self._run(self._job_ref), job.n_rec
+
+    def _address(self, a: np.ndarray | None) -> int | None:
+        # run_transient passes the same record buffers at every segment: convert each once
+        if a is None:
+            return None
+        hit = self._addresses.get(id(a))
+        if hit is None or hit[0] is not a:
+            if len(self._addresses) > 32:
+                self._addresses.clear()
+            hit = self._addresses[id(a)] = (a, kernel.ptr(a))
+        return hit[1]
 
     # state for rollback (FMU get/set state)
     def get_state(self) -> tuple:
@@ -318,7 +357,7 @@ def run_transient(
     if not math.isfinite(me) or me < 0:
         raise ParameterError(f"me: {me} out of range; accepted range [0, inf) kg m")
     omega_fn = omega if callable(omega) else (lambda _t, w=float(omega): w)
-    ts = np.linspace(0.0, t_end, 201)
+    ts = np.linspace(0.0, t_end, 201) if callable(omega) else np.zeros(1)
     speeds = np.array([omega_fn(t) for t in ts])
     if not np.all(np.isfinite(speeds)) or np.any(speeds < 0):
         raise ParameterError("omega: spin speed must be finite and >= 0 rad/s over the whole run")
@@ -374,10 +413,12 @@ def run_transient(
         bar.close()
     t_rec = (np.arange(written) + 1) * rec_every * dt_
     q_rec = rec_q[:written]
-    om = np.array([omega_fn(t) for t in t_rec])
+    if constant:
+        om = np.full(written, float(omega))
+    else:  # with hold: the speed held over the interval that ends at the record
+        om = np.array([omega_fn(t - hold if hold is not None else t) for t in t_rec])
     if hold is not None:
-        phi = np.array(phi_rec[:written])
-        om = np.array([omega_fn(t - hold) for t in t_rec])  # the speed held over the last interval
+        phi = np.array(phi_rec[:written])  # the held intervals' angles, recorded as the run went
     elif constant or written == 0:
         phi = om * t_rec
     else:  # frame angle: trapezoidal integral of the spin-speed history

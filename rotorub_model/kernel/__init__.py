@@ -10,7 +10,7 @@ The shared library is found, in this order:
 4. otherwise it is compiled once into that cache (see :mod:`.compiler`), which takes a
    second with the system compiler and a few with ziglang.
 
-The source id is a hash of the C sources, so an edited kernel is rebuilt and two versions
+The source id is a hash of the C sources and flags, so an edited kernel is rebuilt and two versions
 of the library never load each other's binary.
 """
 
@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .compiler import CompilerError, compile_shared, host_platform_tag, host_suffix
+from .compiler import CFLAGS, CompilerError, compile_shared, host_platform_tag, host_suffix
 
 HERE = Path(__file__).resolve().parent
 SOURCES = (HERE / "rotorub_kernel.c",)
@@ -38,8 +38,10 @@ OUT_BLADE_NAMES = ("F_N", "F_T", "gap_LE", "gap_TE", "gap_tip", "contact_fractio
 OUT_GLOBAL_NAMES = ("casing_force.x", "casing_force.y", "casing_force.z", "friction_torque",
                     "disk_displacement.x", "disk_displacement.y", "gap_min", "n_contact")
 
-_dp = ctypes.POINTER(ctypes.c_double)
-_ip = ctypes.POINTER(ctypes.c_int)
+# arrays cross as plain addresses (c_void_p): an int from ``a.ctypes.data`` converts fastest,
+# and hot callers cache it
+_dp = ctypes.c_void_p
+_ip = ctypes.c_void_p
 
 
 class RRContact(ctypes.Structure):
@@ -59,8 +61,17 @@ class RRState(ctypes.Structure):
                 ("q", _dp), ("q_prev", _dp)]
 
 
+class RRJob(ctypes.Structure):
+    _fields_ = [("state", ctypes.c_void_p), ("contact", ctypes.c_void_p), ("mats", ctypes.c_void_p),
+                ("n_steps", ctypes.c_int), ("omega", ctypes.c_double), ("me", ctypes.c_double),
+                ("t_ramp", ctypes.c_double), ("rec_every", ctypes.c_int), ("rec_cap", ctypes.c_int),
+                ("n_rec", ctypes.c_int), ("rec_q", _dp), ("rec_out", _dp), ("out_index", _ip), ("out_dest", _dp),
+                ("done", ctypes.c_int)]
+
+
 def source_id() -> str:
-    h = hashlib.sha256()
+    """Hash of the kernel's sources and compiler flags (names the binary; checked when loading one)."""
+    h = hashlib.sha256(" ".join(CFLAGS).encode())
     for p in (*SOURCES, HEADER):
         h.update(p.name.encode())
         h.update(p.read_bytes().replace(b"\r\n", b"\n"))
@@ -101,10 +112,8 @@ def _declare(lib: ctypes.CDLL) -> ctypes.CDLL:
     lib.rr_gaps_batch.argtypes = [c, ctypes.c_int, _dp, _dp]
     lib.rr_outputs.argtypes = [c, _dp, ctypes.c_double, _ip, _dp]
     lib.rr_outputs_batch.argtypes = [c, ctypes.c_int, _dp, _dp]
-    lib.rr_cd_advance.argtypes = [ctypes.POINTER(RRState), c, ctypes.POINTER(RRMatrices), ctypes.c_int,
-                                  ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_int, ctypes.c_int,
-                                  _dp, _dp, _ip, _ip, _dp]
-    lib.rr_cd_advance.restype = ctypes.c_int
+    lib.rr_cd_run.argtypes = [ctypes.c_void_p]
+    lib.rr_cd_run.restype = ctypes.c_int
     for name in ("rr_blade_law", "rr_laws", "rr_force", "rr_jacobian", "rr_gaps_batch", "rr_outputs",
                  "rr_outputs_batch"):
         getattr(lib, name).restype = None
@@ -166,15 +175,20 @@ def point_law(g: float, k: float) -> tuple[float, float]:
     return out[0], out[2]
 
 
-def ptr(a: np.ndarray):
-    """A double* on a C-contiguous float64 array (the array must outlive its use)."""
-    return a.ctypes.data_as(_dp)
+def ptr(a: np.ndarray) -> int:
+    """Address of a C-contiguous float64 array, for a double* argument (the array must outlive its use)."""
+    if a.dtype != np.float64 or not a.flags.c_contiguous:
+        raise TypeError("kernel arrays are C-contiguous float64")
+    return a.ctypes.data
 
 
-def iptr(a: np.ndarray):
-    return a.ctypes.data_as(_ip)
+def iptr(a: np.ndarray) -> int:
+    """Address of a C-contiguous C-int array, for an int* argument."""
+    if a.dtype != np.intc or not a.flags.c_contiguous:
+        raise TypeError("kernel index arrays are C-contiguous intc")
+    return a.ctypes.data
 
 
 __all__ = ["ABI_VERSION", "CompilerError", "LAW_WIDTH", "OUT_BLADE_NAMES", "OUT_GLOBAL_NAMES", "RRContact",
-           "RRMatrices", "RRState", "build", "cache_dir", "chord_law", "iptr", "load", "point_law", "ptr",
+           "RRJob", "RRMatrices", "RRState", "build", "cache_dir", "chord_law", "iptr", "load", "point_law", "ptr",
            "source_id"]

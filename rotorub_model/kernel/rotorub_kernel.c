@@ -219,64 +219,82 @@ void rr_outputs_batch(const rr_contact *c, int m, const double *Q, double *out)
 
 /* ------------------------------------------------------------------ central differences */
 
-/* (M/dt^2 + C/2dt) q+ = r F + F_nl(q) + (2M/dt^2 - K) q - (M/dt^2 - C/2dt) q-, with the contact
- * force at the current q only (explicit). The order of the sums is fixed (see the header). */
-int rr_cd_advance(rr_cd_state *s, const rr_contact *c, const rr_cd_matrices *m, int n_steps,
-                  double omega, double me, double t_ramp, int rec_every, int rec_cap,
-                  double *rec_q, double *rec_out, int *n_rec, const int *out_index, double *out_dest)
+/* One step: (M/dt^2 + C/2dt) q+ = r F + F_nl(q) + (2M/dt^2 - K) q - (M/dt^2 - C/2dt) q-, with the
+ * contact force at the current q only (explicit), from the laws already evaluated at q. The order
+ * of the sums is fixed (see the header); locals and restrict let the compiler keep the matrices
+ * streaming instead of reloading the structs after every store. */
+static void cd_update(int n, int nb, const double *restrict law, const double *restrict A,
+                      const double *restrict B, const double *restrict C, const double *restrict D, double mu,
+                      const double *restrict Ainv, const double *restrict K2, const double *restrict Cm1,
+                      const double *restrict f, double r, double *restrict q, double *restrict qp,
+                      double *restrict rhs)
 {
-    int i, j, k, e, n = c->n, nb = c->nb, np = c->np, rows = nb * np;
-    int done = 0, written = n_rec ? *n_rec : 0;
+    int j, k, e;
+    for (k = 0; k < n; ++k) {
+        double acc = r * f[k];
+        const double *K2k = K2 + (size_t)k * n, *Cm1k = Cm1 + (size_t)k * n;
+        for (j = 0; j < nb; ++j) {
+            double FN = law[RR_LAW_WIDTH * j], MN = law[RR_LAW_WIDTH * j + 1];
+            size_t o = (size_t)j * n + k;
+            if (FN == 0.0 && MN == 0.0) continue; /* adds an exact zero */
+            acc += A[o] * FN + B[o] * MN - mu * (C[o] * FN + D[o] * MN);
+        }
+        for (e = 0; e < n; ++e) acc += K2k[e] * q[e] - Cm1k[e] * qp[e];
+        rhs[k] = acc;
+    }
+    for (k = 0; k < n; ++k) qp[k] = q[k];
+    for (k = 0; k < n; ++k) {
+        const double *Ak = Ainv + (size_t)k * n;
+        double acc = 0.0;
+        for (e = 0; e < n; ++e) acc += Ak[e] * rhs[e];
+        q[k] = acc;
+    }
+}
+
+/* The law is evaluated once per state: at the end of a step it serves both the record of the
+ * new state and the next step's contact force. */
+int rr_cd_run(rr_cd_job *job)
+{
+    rr_cd_state *s = job->state;
+    const rr_contact *c = job->contact;
+    const rr_cd_matrices *m = job->mats;
+    int i, k, n = c->n, nb = c->nb, rows = nb * c->np;
+    int done = 0, written = job->n_rec, rec_every = job->rec_every < 1 ? 1 : job->rec_every;
     double *gaps = c->work, *law = c->work + rows;
     double *rhs = law + nb * RR_LAW_WIDTH;
     double *q = s->q, *qp = s->q_prev;
-    const double t0 = s->t, dt = s->dt;
+    const double t0 = s->t, dt = s->dt, floor_gap = -s->max_pen, t_ramp = job->t_ramp, me = job->me;
     const long long step0 = s->steps;
-    if (rec_every < 1) rec_every = 1;
+    job->done = 0;
     if (s->diverged) return 0;
-    for (i = 0; i < n_steps; ++i) {
+    gaps_of(c, q, gaps);
+    laws_of(c, gaps, law);
+    for (i = 0; i < job->n_steps; ++i) {
         double t = t0 + i * dt;
         double r = (t_ramp <= 0.0 || t >= t_ramp) ? 1.0 : t / t_ramp;
         int bad = 0;
-        r *= me;
-        gaps_of(c, q, gaps);
-        laws_of(c, gaps, law);
         for (k = 0; k < rows; ++k)
-            if (!(gaps[k] > -s->max_pen)) bad = 1;
+            if (!(gaps[k] > floor_gap)) bad = 1;
         if (bad) {
             s->diverged = 1;
             break;
         }
-        for (k = 0; k < n; ++k) {
-            double acc = r * m->f[k];
-            const double *K2 = m->K2 + (size_t)k * n, *Cm1 = m->Cm1 + (size_t)k * n;
-            for (j = 0; j < nb; ++j) {
-                double FN = law[RR_LAW_WIDTH * j], MN = law[RR_LAW_WIDTH * j + 1];
-                size_t o = (size_t)j * n + k;
-                if (FN == 0.0 && MN == 0.0) continue; /* adds an exact zero */
-                acc += c->A[o] * FN + c->B[o] * MN - c->mu * (c->C[o] * FN + c->D[o] * MN);
-            }
-            for (e = 0; e < n; ++e) acc += K2[e] * q[e] - Cm1[e] * qp[e];
-            rhs[k] = acc;
-        }
-        for (k = 0; k < n; ++k) qp[k] = q[k];
-        for (k = 0; k < n; ++k) {
-            const double *Ai = m->Ainv + (size_t)k * n;
-            double acc = 0.0;
-            for (e = 0; e < n; ++e) acc += Ai[e] * rhs[e];
-            q[k] = acc;
-        }
+        cd_update(n, nb, law, c->A, c->B, c->C, c->D, c->mu, m->Ainv, m->K2, m->Cm1, m->f, r * me, q, qp, rhs);
         ++done;
-        if ((step0 + i + 1) % rec_every == 0 && written < rec_cap) {
-            for (k = 0; k < n; ++k) rec_q[(size_t)written * n + k] = q[k];
-            if (rec_out) rr_outputs(c, q, 0.0, NULL, rec_out + (size_t)written * RR_N_OUT(nb));
+        gaps_of(c, q, gaps);
+        laws_of(c, gaps, law);
+        if ((step0 + i + 1) % rec_every == 0 && written < job->rec_cap) {
+            for (k = 0; k < n; ++k) job->rec_q[(size_t)written * n + k] = q[k];
+            if (job->rec_out)
+                outputs_from_law(c, q, gaps, law, 0.0, NULL, job->rec_out + (size_t)written * RR_N_OUT(nb));
             ++written;
         }
     }
     s->steps += done;
     s->t += done * dt;
-    s->phi += done * dt * omega;
-    if (n_rec) *n_rec = written;
-    if (out_dest) rr_outputs(c, q, s->phi, out_index, out_dest);
+    s->phi += done * dt * job->omega;
+    job->n_rec = written;
+    job->done = done;
+    if (job->out_dest) outputs_from_law(c, q, gaps, law, s->phi, job->out_index, job->out_dest);
     return done;
 }

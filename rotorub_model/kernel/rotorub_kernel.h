@@ -134,16 +134,30 @@ RR_API void rr_outputs(const rr_contact *c, const double *q, double phi, const i
 /* Outputs of m states (m x n) in the rotating frame, into out (m x RR_N_OUT(nb)). */
 RR_API void rr_outputs_batch(const rr_contact *c, int m, const double *Q, double *out);
 
-/* Advance n_steps central-difference steps at constant matrices. The imbalance force is
- * f * me * r(t), r = min(t / t_ramp, 1) (t_ramp <= 0: r = 1). Every rec_every-th step (counted
- * from the start of the run, s->steps) the new q and its rotating-frame outputs are written to
- * rec_q[*n_rec] and rec_out[*n_rec] while *n_rec < rec_cap (rec_cap = 0: no records).
- * omega [rad/s] advances the frame angle. If out_dest is not NULL the outputs of the final
- * state, rotated by the final phi, are written there through out_index (see rr_outputs).
- * Returns the steps done (fewer than n_steps if the run diverged: s->diverged is then set). */
-RR_API int rr_cd_advance(rr_cd_state *s, const rr_contact *c, const rr_cd_matrices *m, int n_steps,
-                         double omega, double me, double t_ramp, int rec_every, int rec_cap,
-                         double *rec_q, double *rec_out, int *n_rec, const int *out_index, double *out_dest);
+/* One call of the time loop: what to advance, with what, and where to put the results. A caller
+ * that steps often (an FMU) keeps one job and only changes n_steps, omega and me between calls. */
+typedef struct {
+    rr_cd_state *state;
+    const rr_contact *contact;
+    const rr_cd_matrices *mats;
+    int n_steps;          /* steps to take */
+    double omega;         /* spin speed [rad/s]: advances the frame angle */
+    double me;            /* imbalance m e [kg m] */
+    double t_ramp;        /* imbalance ramp r(t) = min(t / t_ramp, 1); <= 0: r = 1 */
+    int rec_every;        /* record every rec_every-th step of the run (counted by state->steps) */
+    int rec_cap;          /* rows of rec_q / rec_out (0: no records) */
+    int n_rec;            /* in: first free row; out: rows written */
+    double *rec_q;        /* (rec_cap, n) the recorded q */
+    double *rec_out;      /* (rec_cap, RR_N_OUT(nb)) their outputs, rotating frame (NULL: none) */
+    const int *out_index; /* outputs of the final state (fixed frame) go to out_dest[out_index[k]] */
+    double *out_dest;     /* (NULL: not written) */
+    int done;             /* out: steps done (fewer than n_steps if the run diverged) */
+} rr_cd_job;
+
+/* Advance job->n_steps central-difference steps at constant matrices, imbalance force
+ * f * me * r(t). Returns the steps done; fewer than n_steps if a gap fell below -max_pen or a
+ * value stopped being finite (state->diverged is then set and further calls do nothing). */
+RR_API int rr_cd_run(rr_cd_job *job);
 
 #ifdef __cplusplus
 }
