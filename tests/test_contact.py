@@ -454,3 +454,23 @@ def test_friction_torque_3d_brakes(model, crit):
 def test_bad_input(model, args, kwargs, name):
     with pytest.raises(ParameterError, match=name):
         make_contact(model, *args, **kwargs)
+
+
+@pytest.mark.parametrize("form, theta, chord, rotations", [
+    ("2D", 0.0, 0.0, True), ("3D", np.radians(5.0), 0.2, True), ("3D", np.radians(30.0), 0.05, True),
+    ("3D", 0.0, 1e-3, True), ("3D", np.radians(5.0), 0.2, False)])
+def test_kernel_geometry_equals_an_independent_construction(model, form, theta, chord, rotations):
+    """rr_contact_geometry (C) against the numpy construction of tests/reference/geometry.py:
+    points, normals, tangents and both point-displacement maps, to round-off."""
+    from reference.geometry import reference_geometry
+
+    from rotorub_model.contact.geometry import build_geometry
+
+    geo = build_geometry(model, 1 if form == "2D" else 2, theta, chord, rotations)
+    ref = reference_geometry(model, form, theta, chord, rotations)
+    for name, a, b in zip(("points", "normals", "tangents", "Jb", "Jc"),
+                          (geo.points, geo.normals, geo.tangents, geo.Jb, geo.Jc), ref):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-14 * max(1.0, np.abs(b).max()), err_msg=name)
+    rel = ref[3] - ref[4]
+    G = -np.einsum("jpi,jpin->jpn", ref[1], rel).reshape(-1, model.n_dofs)
+    np.testing.assert_allclose(geo.G, G, rtol=0, atol=1e-14 * np.abs(G).max())

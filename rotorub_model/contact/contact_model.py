@@ -61,7 +61,7 @@ class ContactModel:
     g0: float
     k_r: float
     mu: float
-    G: np.ndarray = field(init=False)  # (N*P, n) gap gradients
+    G: np.ndarray = field(init=False)  # (N*P, n) gap gradients (the geometry's)
     A: np.ndarray = field(init=False)  # (N, n) d eta / dq
     B: np.ndarray = field(init=False)  # (N, n) d zeta / dq
     C: np.ndarray = field(init=False)  # (N, n) d t_mid / dq
@@ -69,35 +69,16 @@ class ContactModel:
 
     def __post_init__(self) -> None:
         g = self.geometry
-        rel = g.Jb - g.Jc
-        Gk = -np.einsum("jpi,jpin->jpn", g.normals, rel)
-        Tk = np.einsum("jpi,jpin->jpn", g.tangents, rel)
-        self.n_blades, self.n_points = Gk.shape[:2]
-        self.G = Gk.reshape(-1, Gk.shape[-1])
-        if self.n_points == 2:
-            self.A = 0.5 * (Gk[:, 0] + Gk[:, 1])
-            self.B = (Gk[:, 1] - Gk[:, 0]) / g.chord
-            self.C = 0.5 * (Tk[:, 0] + Tk[:, 1])
-            self.D = (Tk[:, 1] - Tk[:, 0]) / g.chord
-        else:
-            self.A = Gk[:, 0]
-            self.B = np.zeros_like(self.A)
-            self.C = Tk[:, 0]
-            self.D = np.zeros_like(self.A)
+        self.n_blades, self.n_points = g.points.shape[:2]
+        self.G, self.A, self.B, self.C, self.D = g.G, g.A, g.B, g.C, g.D
         # The casing resultant and the rotor torque are linear in (F_N, M_N) of each blade:
-        # precompute those maps once so per-state outputs cost two small products.
-        nc = g.normals + self.mu * g.tangents  # (N, P, 3) force direction per unit weight, on the casing
-        r = g.points
-        arm = -(r[..., 0] * nc[..., 1] - r[..., 1] * nc[..., 0])  # (N, P) torque on the rotor per unit weight
-        if self.n_points == 2:
-            c = max(g.chord, 1e-300)
-            self._res_F = 0.5 * (nc[:, 0] + nc[:, 1])
-            self._res_M = (nc[:, 1] - nc[:, 0]) / c
-            self._tq_F = 0.5 * (arm[:, 0] + arm[:, 1])
-            self._tq_M = (arm[:, 1] - arm[:, 0]) / c
-        else:
-            self._res_F, self._res_M = nc[:, 0], np.zeros_like(nc[:, 0])
-            self._tq_F, self._tq_M = arm[:, 0], np.zeros_like(arm[:, 0])
+        # maps built once (by the kernel, with this mu) so per-state outputs cost two small products.
+        N = self.n_blades
+        self._res_F, self._res_M = np.zeros((N, 3)), np.zeros((N, 3))
+        self._tq_F, self._tq_M = np.zeros(N), np.zeros(N)
+        kernel.load().rr_contact_resultants(
+            N, self.n_points, float(g.chord), float(self.mu), *(kernel.ptr(np.ascontiguousarray(a)) for a in (
+                g.points, g.normals, g.tangents)), *map(kernel.ptr, (self._res_F, self._res_M, self._tq_F, self._tq_M)))
         self._k = None
 
     # ------------------------------------------------------------------ the kernel's view

@@ -1,10 +1,23 @@
-"""The geometry a contact formulation hands to the contact model (no behaviour, no imports of the formulations)."""
+"""The geometry a contact formulation hands to the contact model, built by the kernel.
+
+``build_geometry`` collects what the geometry is made of (the fan-disk maps T and R of the
+shaft, the blades' Ritz values at the tip, the casing's dofs and ring modes, the cone and
+the chord) and lets the kernel's ``rr_contact_geometry`` build the points, normals, the
+point displacement maps J_b, J_c and the gap gradients: one construction for the library,
+the pythonfmu FMU and the native FMU (which makes it at initialisation from the same
+ingredients, baked at build time).
+"""
 
 from __future__ import annotations
 
+import ctypes
 from dataclasses import dataclass
 
 import numpy as np
+
+from .. import kernel
+from ..structure.model import Model
+from ..structure.ritz import cantilever_basis
 
 
 @dataclass
@@ -18,3 +31,44 @@ class ContactGeometry:
     Jc: np.ndarray  # (N, P, 3, n) casing-point displacement maps
     chord: float  # l_c (0 for the point law)
     disk: np.ndarray  # (2, n) fan-disk centre translation (rotating x, y): an output of every state
+    G: np.ndarray  # (N*P, n) gap gradients: gap = g0 + G q
+    A: np.ndarray  # (N, n) d eta / dq (mean gap along the chord)
+    B: np.ndarray  # (N, n) d zeta / dq (gap slope)
+    C: np.ndarray  # (N, n) d t_mid / dq (sliding, mean)
+    D: np.ndarray  # (N, n) d t_slope / dq
+
+
+def geometry_spec(model: Model, n_points: int, theta: float, chord: float, rotations: bool) -> dict:
+    """The ingredients of rr_geometry_spec (plain numbers and arrays): what the native FMU bakes."""
+    p = model.params
+    T, R = model.disk_maps
+    return {
+        "n": model.n_dofs, "nb": p.blades.count, "np": n_points, "rotations": int(bool(rotations)),
+        "r_tip": p.blades.tip_radius, "stagger": float(np.radians(p.blades.stagger_deg)), "theta": float(theta),
+        "chord": float(chord), "z_cg": p.casing.z_cg, "blade_dof0": model.slices["blades"].start,
+        "n_ritz": p.blades.n_ritz,
+        "psi_tip": np.ascontiguousarray(cantilever_basis(p.blades.length, p.blades.length, p.blades.n_ritz)[0]),
+        "casing_dof0": model.slices["casing"].start, "modes": np.asarray(p.casing.modes, dtype=np.intc),
+        "T": np.ascontiguousarray(T, dtype=float), "Rot": np.ascontiguousarray(R, dtype=float),
+    }
+
+
+def build_geometry(model: Model, n_points: int, theta: float = 0.0, chord: float = 0.0,
+                   rotations: bool = True) -> ContactGeometry:
+    """The kernel's contact geometry: 2D point tips (``n_points=1``) or 3D LE/TE (``n_points=2``)."""
+    s = geometry_spec(model, n_points, theta, chord, rotations)
+    N, P, n = s["nb"], n_points, s["n"]
+    lib = kernel.load()
+    spec = kernel.RRGeometrySpec(
+        n, N, P, s["rotations"], s["r_tip"], s["stagger"], s["theta"], s["chord"], s["z_cg"], s["blade_dof0"],
+        s["n_ritz"], kernel.ptr(s["psi_tip"]), s["casing_dof0"], len(s["modes"]), kernel.iptr(s["modes"]),
+        kernel.ptr(s["T"]), kernel.ptr(s["Rot"]))
+    out = {k: np.zeros(shape) for k, shape in (
+        ("points", (N, P, 3)), ("normals", (N, P, 3)), ("tangents", (N, P, 3)), ("Jb", (N, P, 3, n)),
+        ("Jc", (N, P, 3, n)), ("G", (N * P, n)), ("A", (N, n)), ("B", (N, n)), ("C", (N, n)), ("D", (N, n)),
+        ("disk", (2, n)))}
+    geo = kernel.RRGeometry(*(kernel.ptr(out[k]) for k in ("points", "normals", "tangents", "Jb", "Jc", "G", "A",
+                                                            "B", "C", "D", "disk")))
+    if lib.rr_contact_geometry(ctypes.byref(spec), ctypes.byref(geo)) != 0:
+        raise ValueError(f"contact geometry: invalid specification (points {P}, chord {chord!r} m)")
+    return ContactGeometry(chord=float(chord if P == 2 else 0.0), **out)

@@ -29,7 +29,7 @@ from .compiler import CFLAGS, CompilerError, compile_shared, host_platform_tag, 
 HERE = Path(__file__).resolve().parent
 SOURCES = (HERE / "rotorub_kernel.c",)
 HEADER = HERE / "rotorub_kernel.h"
-ABI_VERSION = 1
+ABI_VERSION = 2
 LAW_WIDTH = 7
 OUT_BLADE_BLOCKS = 6
 OUT_GLOBALS = 8
@@ -49,6 +49,19 @@ class RRContact(ctypes.Structure):
                 ("k_r", ctypes.c_double), ("mu", ctypes.c_double), ("chord", ctypes.c_double),
                 ("G", _dp), ("A", _dp), ("B", _dp), ("C", _dp), ("D", _dp), ("res_F", _dp), ("res_M", _dp),
                 ("tq_F", _dp), ("tq_M", _dp), ("T2", _dp), ("work", _dp)]
+
+
+class RRGeometrySpec(ctypes.Structure):
+    _fields_ = [("n", ctypes.c_int), ("nb", ctypes.c_int), ("np", ctypes.c_int), ("rotations", ctypes.c_int),
+                ("r_tip", ctypes.c_double), ("stagger", ctypes.c_double), ("theta", ctypes.c_double),
+                ("chord", ctypes.c_double), ("z_cg", ctypes.c_double), ("blade_dof0", ctypes.c_int),
+                ("n_ritz", ctypes.c_int), ("psi_tip", _dp), ("casing_dof0", ctypes.c_int), ("n_modes", ctypes.c_int),
+                ("modes", _ip), ("T", _dp), ("Rot", _dp)]
+
+
+class RRGeometry(ctypes.Structure):
+    _fields_ = [(name, _dp) for name in ("points", "normals", "tangents", "Jb", "Jc", "G", "A", "B", "C", "D",
+                                         "T2")]
 
 
 class RRMatrices(ctypes.Structure):
@@ -104,6 +117,11 @@ def _declare(lib: ctypes.CDLL) -> ctypes.CDLL:
     lib.rr_source_id.restype = ctypes.c_char_p
     lib.rr_work_size.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_int]
     lib.rr_work_size.restype = ctypes.c_int
+    lib.rr_contact_geometry.argtypes = [ctypes.c_void_p, ctypes.c_void_p]
+    lib.rr_contact_geometry.restype = ctypes.c_int
+    lib.rr_contact_resultants.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_double, ctypes.c_double, _dp, _dp,
+                                          _dp, _dp, _dp, _dp, _dp]
+    lib.rr_contact_resultants.restype = None
     lib.rr_blade_law.argtypes = [ctypes.c_int, ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_double,
                                  _dp]
     lib.rr_laws.argtypes = [c, _dp, _dp, _dp]
@@ -189,6 +207,8 @@ def iptr(a: np.ndarray) -> int:
     return a.ctypes.data
 
 
-__all__ = ["ABI_VERSION", "CompilerError", "LAW_WIDTH", "OUT_BLADE_NAMES", "OUT_GLOBAL_NAMES", "RRContact",
-           "RRJob", "RRMatrices", "RRState", "build", "cache_dir", "chord_law", "iptr", "load", "point_law", "ptr",
-           "source_id"]
+__all__ = [
+    "ABI_VERSION", "CompilerError", "LAW_WIDTH", "OUT_BLADE_NAMES", "OUT_GLOBAL_NAMES", "RRContact", "RRGeometry",
+    "RRGeometrySpec", "RRJob", "RRMatrices", "RRState", "build", "cache_dir", "chord_law", "iptr", "load", "point_law",
+    "ptr", "source_id",
+]

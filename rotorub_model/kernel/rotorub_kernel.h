@@ -42,7 +42,7 @@ extern "C" {
 #endif
 
 /* Bumped whenever a struct layout or a signature below changes. */
-#define RR_ABI_VERSION 1
+#define RR_ABI_VERSION 2
 
 /* Per-blade law values (rr_laws): F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction. */
 #define RR_LAW_WIDTH 7
@@ -90,6 +90,40 @@ typedef struct {
     double *work;        /* scratch of at least rr_work_size(n, nb, np) doubles */
 } rr_contact;
 
+/* What the contact geometry is built from: the structure's maps at the fan disk and at the
+ * casing, and the formulation's parameters (rr_contact_geometry). */
+typedef struct {
+    int n;                 /* generalised coordinates */
+    int nb;                /* blades, at angles 2 pi j / nb */
+    int np;                /* 1: 2D point tip; 2: 3D leading and trailing edges */
+    int rotations;         /* 3D: disk/casing rotations and blade flexure enter the gap (0: 'geometry only') */
+    double r_tip;          /* blade-tip radius [m] */
+    double stagger;        /* blade stagger from the axis [rad] */
+    double theta;          /* cone angle of the casing inner surface [rad] (3D) */
+    double chord;          /* blade-tip chord [m] (3D) */
+    double z_cg;           /* axial offset of the casing centre of gravity from the tip plane [m] */
+    int blade_dof0;        /* first blade dof; blade j owns n_ritz dofs from blade_dof0 + j n_ritz */
+    int n_ritz;            /* Ritz functions per blade */
+    const double *psi_tip; /* (n_ritz) their values at the tip */
+    int casing_dof0;       /* first casing dof: translation x, y, tilt x, y, then (cos, sin) per ring mode */
+    int n_modes;           /* ring modes */
+    const int *modes;      /* (n_modes) their nodal diameters */
+    const double *T;       /* (3, n) fan-disk translation */
+    const double *Rot;     /* (3, n) fan-disk rotation vector */
+} rr_geometry_spec;
+
+/* The contact geometry (all caller-allocated, P = np points per blade). */
+typedef struct {
+    double *points;   /* (nb, P, 3) rest positions, rotating frame, z from the tip plane */
+    double *normals;  /* (nb, P, 3) outward normal of the casing surface */
+    double *tangents; /* (nb, P, 3) sliding direction e_t */
+    double *Jb;       /* (nb, P, 3, n) displacement of the blade point */
+    double *Jc;       /* (nb, P, 3, n) displacement of the casing point facing it */
+    double *G;        /* (nb*P, n) gap gradients */
+    double *A, *B, *C, *D; /* (nb, n) d eta, d zeta, d t_mid, d t_slope / dq */
+    double *T2;       /* (2, n) fan-disk translation */
+} rr_geometry;
+
 /* Central-difference matrices at one (Omega, dt): (M/dt^2 + C/2dt)^-1, 2M/dt^2 - K, M/dt^2 - C/2dt. */
 typedef struct {
     int n;
@@ -116,6 +150,14 @@ RR_API const char *rr_source_id(void);
 /* doubles of scratch an rr_contact needs in its work pointer */
 RR_API int rr_work_size(int n, int nb, int np);
 
+/* Build the contact geometry of eq. (1) (2D) or eq. (3)-(4) linearised (3D; see docs/THEORY.md 4).
+ * Returns 0, or -1 if the spec is invalid (np not 1 or 2, chord <= 0 in 3D). */
+RR_API int rr_contact_geometry(const rr_geometry_spec *spec, rr_geometry *out);
+/* The casing resultant and the rotor torque per unit F_N and M_N of each blade (linear maps,
+ * with friction mu): res_F, res_M (nb, 3), tq_F, tq_M (nb). */
+RR_API void rr_contact_resultants(int nb, int np, double chord, double mu, const double *points,
+                                  const double *normals, const double *tangents, double *res_F, double *res_M,
+                                  double *tq_F, double *tq_M);
 /* The law of one blade from its gaps: np = 2 chord law (g_le, g_te), np = 1 point law (g_le). */
 RR_API void rr_blade_law(int np, double g_le, double g_te, double k, double l, double *out);
 /* Gaps (nb*np) and per-blade law values (nb x RR_LAW_WIDTH) at q. */
