@@ -53,7 +53,7 @@ def all_closed_stiffness(contact: ContactModel) -> np.ndarray:
 def critical_time_step(model: Model, contact: ContactModel, omega: float) -> float:
     """2 / w_max of the linearised system with all contacts closed [s]."""
     Kc = model.K_omega(omega) + all_closed_stiffness(contact)
-    lam = np.linalg.eigvals(np.linalg.solve(model.M, Kc))
+    lam = kernel.eigenvalues(kernel.inverse(model.M) @ Kc)  # the FMUs' eigen-solver, so all pick the same step
     return 2.0 / math.sqrt(float(np.max(np.abs(lam))))
 
 
@@ -136,14 +136,18 @@ class CentralDifference:
     def _matrices(self, omega: float, omega_dot: float) -> kernel.RRMatrices:
         key = (omega, omega_dot, self.dt)
         if key != self._key:
-            m, dt = self.model, self.dt
-            C = m.D + m.G(omega)
-            K = m.K_omega(omega) + omega_dot * m.E1
-            Aeff = m.M / dt**2 + C / (2 * dt)
-            arrays = (np.linalg.inv(Aeff), 2 * m.M / dt**2 - K, m.M / dt**2 - C / (2 * dt),
-                      np.ascontiguousarray(m.force(omega, 1.0, omega_dot)))
-            arrays = tuple(np.ascontiguousarray(a, dtype=float) for a in arrays)
-            mats = kernel.RRMatrices(m.n_dofs, *map(kernel.ptr, arrays))
+            m, n = self.model, self.model.n_dofs
+            Ainv, K2, Cm1 = np.empty((n, n)), np.empty((n, n)), np.empty((n, n))
+            work, piv = np.empty(2 * n * n), np.empty(n, dtype=np.intc)  # named: alive during the call
+            structure = [np.ascontiguousarray(getattr(m, k), dtype=float)
+                         for k in ("M", "D", "K", "G1", "C1", "N2", "S2", "E1")]
+            # assembled and inverted by the kernel: the FMUs build the same matrices with the same code
+            if self.contact.lib.rr_cd_build(
+                    n, *map(kernel.ptr, structure), float(omega), float(omega_dot), float(self.dt), kernel.ptr(Ainv),
+                    kernel.ptr(K2), kernel.ptr(Cm1), kernel.ptr(work), kernel.iptr(piv)) != 0:
+                raise ParameterError(f"dt: {self.dt:g} s: the central-difference matrix is singular")
+            arrays = (Ainv, K2, Cm1, np.ascontiguousarray(m.force(omega, 1.0, omega_dot), dtype=float))
+            mats = kernel.RRMatrices(n, *map(kernel.ptr, arrays))
             self._mats = (mats, arrays)
             self._job.mats = ctypes.addressof(mats)
             self._key = key

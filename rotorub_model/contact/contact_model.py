@@ -76,9 +76,10 @@ class ContactModel:
         N = self.n_blades
         self._res_F, self._res_M = np.zeros((N, 3)), np.zeros((N, 3))
         self._tq_F, self._tq_M = np.zeros(N), np.zeros(N)
+        pts = [np.ascontiguousarray(a, dtype=float) for a in (g.points, g.normals, g.tangents)]  # alive: named
         kernel.load().rr_contact_resultants(
-            N, self.n_points, float(g.chord), float(self.mu), *(kernel.ptr(np.ascontiguousarray(a)) for a in (
-                g.points, g.normals, g.tangents)), *map(kernel.ptr, (self._res_F, self._res_M, self._tq_F, self._tq_M)))
+            N, self.n_points, float(g.chord), float(self.mu), *map(kernel.ptr, pts),
+            *map(kernel.ptr, (self._res_F, self._res_M, self._tq_F, self._tq_M)))
         self._k = None
 
     # ------------------------------------------------------------------ the kernel's view

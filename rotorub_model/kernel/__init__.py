@@ -29,7 +29,7 @@ from .compiler import CFLAGS, CompilerError, compile_shared, host_platform_tag, 
 HERE = Path(__file__).resolve().parent
 SOURCES = (HERE / "rotorub_kernel.c",)
 HEADER = HERE / "rotorub_kernel.h"
-ABI_VERSION = 2
+ABI_VERSION = 3
 LAW_WIDTH = 7
 OUT_BLADE_BLOCKS = 6
 OUT_GLOBALS = 8
@@ -122,6 +122,17 @@ def _declare(lib: ctypes.CDLL) -> ctypes.CDLL:
     lib.rr_contact_resultants.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_double, ctypes.c_double, _dp, _dp,
                                           _dp, _dp, _dp, _dp, _dp]
     lib.rr_contact_resultants.restype = None
+    lib.rr_lu.argtypes = [ctypes.c_int, _dp, _ip]
+    lib.rr_lu.restype = ctypes.c_int
+    lib.rr_lu_solve.argtypes = [ctypes.c_int, _dp, _ip, _dp]
+    lib.rr_lu_solve.restype = None
+    lib.rr_inverse.argtypes = [ctypes.c_int, _dp, _dp, _dp, _ip]
+    lib.rr_inverse.restype = ctypes.c_int
+    lib.rr_eigenvalues.argtypes = [ctypes.c_int, _dp, _dp, _dp, _dp]
+    lib.rr_eigenvalues.restype = ctypes.c_int
+    lib.rr_cd_build.argtypes = [ctypes.c_int, *[_dp] * 8, ctypes.c_double, ctypes.c_double, ctypes.c_double,
+                                _dp, _dp, _dp, _dp, _ip]
+    lib.rr_cd_build.restype = ctypes.c_int
     lib.rr_blade_law.argtypes = [ctypes.c_int, ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_double,
                                  _dp]
     lib.rr_laws.argtypes = [c, _dp, _dp, _dp]
@@ -193,6 +204,27 @@ def point_law(g: float, k: float) -> tuple[float, float]:
     return out[0], out[2]
 
 
+def eigenvalues(A: np.ndarray) -> np.ndarray:
+    """The kernel's eigenvalues of a real square matrix (balancing, Hessenberg, double-shift QR): what
+    the FMUs compute in C, so the library's step limits and stability indicators match theirs."""
+    n = A.shape[0]
+    a = np.array(A, dtype=float, order="C")
+    wr, wi, work = np.empty(n), np.empty(n), np.empty(n)
+    if load().rr_eigenvalues(n, ptr(a), ptr(wr), ptr(wi), ptr(work)) != 0:
+        raise np.linalg.LinAlgError("eigenvalues: the QR iteration did not converge")
+    return wr + 1j * wi
+
+
+def inverse(A: np.ndarray) -> np.ndarray:
+    """The kernel's inverse (LU with partial pivoting)."""
+    n = A.shape[0]
+    a = np.ascontiguousarray(A, dtype=float)
+    out, work, piv = np.empty((n, n)), np.empty((n, n)), np.empty(n, dtype=np.intc)
+    if load().rr_inverse(n, ptr(a), ptr(out), ptr(work), iptr(piv)) != 0:
+        raise np.linalg.LinAlgError("inverse: singular matrix")
+    return out
+
+
 def ptr(a: np.ndarray) -> int:
     """Address of a C-contiguous float64 array, for a double* argument (the array must outlive its use)."""
     if a.dtype != np.float64 or not a.flags.c_contiguous:
@@ -209,6 +241,6 @@ def iptr(a: np.ndarray) -> int:
 
 __all__ = [
     "ABI_VERSION", "CompilerError", "LAW_WIDTH", "OUT_BLADE_NAMES", "OUT_GLOBAL_NAMES", "RRContact", "RRGeometry",
-    "RRGeometrySpec", "RRJob", "RRMatrices", "RRState", "build", "cache_dir", "chord_law", "iptr", "load", "point_law",
-    "ptr", "source_id",
+    "RRGeometrySpec", "RRJob", "RRMatrices", "RRState", "build", "cache_dir", "chord_law", "eigenvalues", "inverse",
+    "iptr", "load", "point_law", "ptr", "source_id",
 ]

@@ -42,7 +42,7 @@ extern "C" {
 #endif
 
 /* Bumped whenever a struct layout or a signature below changes. */
-#define RR_ABI_VERSION 2
+#define RR_ABI_VERSION 3
 
 /* Per-blade law values (rr_laws): F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction. */
 #define RR_LAW_WIDTH 7
@@ -200,6 +200,27 @@ typedef struct {
  * f * me * r(t). Returns the steps done; fewer than n_steps if a gap fell below -max_pen or a
  * value stopped being finite (state->diverged is then set and further calls do nothing). */
 RR_API int rr_cd_run(rr_cd_job *job);
+
+/* ------------------------------------------------------------------ dense linear algebra */
+/* LU with partial pivoting, in place (n x n row-major); returns 0, or -1 if a pivot is zero. */
+RR_API int rr_lu(int n, double *A, int *piv);
+/* Solve LU x = b in place after rr_lu. */
+RR_API void rr_lu_solve(int n, const double *LU, const int *piv, double *b);
+/* Ainv = A^-1 (A untouched); work: n*n doubles, piv: n ints. Returns 0 or -1 (singular). */
+RR_API int rr_inverse(int n, const double *A, double *Ainv, double *work, int *piv);
+/* Eigenvalues wr + i wi of A (n x n, destroyed): balancing, Householder reduction to Hessenberg
+ * form, Francis double-shift QR (no eigenvectors); work: n doubles. Returns 0, or -1 if the QR
+ * iteration did not converge. */
+RR_API int rr_eigenvalues(int n, double *A, double *wr, double *wi, double *work);
+
+/* The central-difference matrices at spin speed omega, angular acceleration omega_dot and step dt,
+ * assembled in the library's order of operations: C = D + omega G1,
+ * K = K0 + omega^2 (S2 + N2) + omega C1 + omega_dot E1 (E1 may be NULL),
+ * Ainv = (M/dt^2 + C/2dt)^-1, K2 = 2M/dt^2 - K, Cm1 = M/dt^2 - C/2dt.
+ * work: 2 n*n doubles, piv: n ints. Returns 0 or -1 (singular). */
+RR_API int rr_cd_build(int n, const double *M, const double *D, const double *K0, const double *G1,
+                       const double *C1, const double *N2, const double *S2, const double *E1, double omega,
+                       double omega_dot, double dt, double *Ainv, double *K2, double *Cm1, double *work, int *piv);
 
 #ifdef __cplusplus
 }

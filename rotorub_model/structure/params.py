@@ -33,9 +33,11 @@ REFERENCE_FILE = Path(__file__).resolve().parents[1] / "data" / "reference.toml"
 INF = math.inf
 
 
-def _f(lo: float, hi: float = INF, *, lo_open: bool = False, doc: str = "", integer: bool = False):
-    """A dataclass field with an accepted range [lo, hi] (or (lo, hi] if lo_open)."""
-    return field(metadata={"range": (lo, hi, lo_open), "doc": doc, "integer": integer})
+def _f(lo: float, hi: float = INF, *, lo_open: bool = False, doc: str = "", integer: bool = False,
+       default: Any = dataclasses.MISSING):
+    """A dataclass field with an accepted range [lo, hi] (or (lo, hi] if lo_open); with a default,
+    the field may be left out of a parameter file."""
+    return field(default=default, metadata={"range": (lo, hi, lo_open), "doc": doc, "integer": integer})
 
 
 @dataclass(frozen=True)
@@ -138,11 +140,18 @@ class ContactParams:
     theta_deg: float = _f(0, 60, doc="inclination of the conical casing inner surface [deg]")
     chord: float = _f(0, lo_open=True, doc="blade tip chord length l_c [m]")
     g0: float = _f(-INF, doc="nominal tip clearance [m] (negative = initial interference)")
+    max_penetration: float = _f(0, 0.05, lo_open=True, default=3.0e-3,
+                                doc="penetration beyond which a transient is declared diverged [m] (default 3 mm: "
+                                    "the depth of a fan-case abradable liner; deeper, the blade cuts the case "
+                                    "structure and the penalty law means nothing)")
 
 
 @dataclass(frozen=True)
 class NormalisationParams:
     omega_ref: float = _f(0, lo_open=True, doc="reference angular speed for the normalised spin speed [rad/s]")
+    speed_max: float = _f(0, lo_open=True, default=12.0,
+                          doc="upper end of the model's validity, normalised (default 12: the paper's range 0-10 "
+                              "with a margin; the FMU refuses faster spin speeds)")
 
 
 @dataclass(frozen=True)
