@@ -24,10 +24,12 @@ Examples
 
 from __future__ import annotations
 
+import ctypes
 from dataclasses import dataclass
 
 import numpy as np
 
+from .. import kernel
 from ..contact import ContactModel
 from ..errors import ConvergenceError, ParameterError
 from ..structure.model import Model
@@ -63,45 +65,6 @@ def _check_omega(omega: float) -> None:
         raise ParameterError(f"omega: {omega} out of range; accepted range [0, inf) rad/s")
 
 
-def _newton(K: np.ndarray, F: np.ndarray, contact: ContactModel, q: np.ndarray, tol: float, max_iter: int):
-    scale = max(np.linalg.norm(F), 1e-12 * np.linalg.norm(K, 1), 1e-30)
-
-    def res(x):
-        return K @ x - contact.forces(x) - F
-
-    r = res(q)
-    nr = np.linalg.norm(r)
-    for it in range(1, max_iter + 1):
-        if nr <= tol * scale:
-            return q, nr / scale, it - 1, True
-        dq = np.linalg.solve(K - contact.jacobian(q), -r)
-        step = 1.0
-        while step > 1e-6:
-            qn = q + step * dq
-            rn = res(qn)
-            nn = np.linalg.norm(rn)
-            if nn < (1 - 1e-4 * step) * nr:
-                break
-            step *= 0.5
-        else:
-            return q, nr / scale, it, False
-        q, r, nr = qn, rn, nn
-    return q, nr / scale, max_iter, nr <= tol * scale
-
-
-def _candidates(K, F, contact, q_lin, starts):
-    """Starting points, cheapest and most likely first (a generator: built lazily)."""
-    yield from starts
-    yield q_lin
-    from .transient import all_closed_stiffness
-
-    Kc = all_closed_stiffness(contact)
-    for frac in (1.0, 0.5, 0.1):
-        yield np.linalg.solve(K + frac * Kc, F)
-    for a in (0.5, 0.25, 1.5, 2.0):
-        yield a * q_lin
-
-
 def solve_static(
     model: Model,
     contact: ContactModel,
@@ -118,29 +81,20 @@ def solve_static(
     touches); if Newton fails, continues in the imbalance from 0 to m e.
     """
     _check_omega(omega)
-    K = model.K_omega(omega)
-    F = model.force(omega, me)
-    q_lin = np.linalg.solve(K, F)
-    starts = [q0] if q0 is not None else []
-    its_total = 0
-    best = None
-    for start in _candidates(K, F, contact, q_lin, starts):
-        q, rel, its, ok = _newton(K, F, contact, np.array(start, dtype=float), tol, max_iter)
-        its_total += its
-        if best is None or rel < best[1]:
-            best = (q, rel)
-        if ok:
-            break
-    if not ok:
-        q = np.zeros(model.n_dofs)
-        for lam in np.linspace(0.1, 1.0, 10):
-            q, rel, its, ok = _newton(K, lam * F, contact, q, tol, max_iter)
-            its_total += its
-            if not ok:
-                break
-        if not ok:
-            q, rel = best
-    its = its_total
+    K = np.ascontiguousarray(model.K_omega(omega), dtype=float)
+    F = np.ascontiguousarray(model.force(omega, me), dtype=float)
+    n = model.n_dofs
+    q = np.empty(n)
+    start = None if q0 is None else np.ascontiguousarray(q0, dtype=float)
+    rel, its = ctypes.c_double(), ctypes.c_int()
+    work = np.empty(contact.lib.rr_static_work_size(n))
+    iwork = np.empty(n, dtype=np.intc)
+    # Newton, its starts and the imbalance continuation run in the kernel (one call): the FMUs'
+    # quasi-static steps are the same code
+    ok = bool(contact.lib.rr_static_solve(
+        contact.kernel, kernel.ptr(K), kernel.ptr(F), None if start is None else kernel.ptr(start), float(tol),
+        int(max_iter), kernel.ptr(q), ctypes.byref(rel), ctypes.byref(its), kernel.ptr(work), kernel.iptr(iwork)))
+    rel, its = rel.value, its.value
     if not ok and raise_on_failure:
         raise ConvergenceError(
             f"static solution at omega={omega:g} rad/s, g0={contact.g0:g} m did not converge "

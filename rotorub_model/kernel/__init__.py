@@ -29,7 +29,7 @@ from .compiler import CFLAGS, CompilerError, compile_shared, host_platform_tag, 
 HERE = Path(__file__).resolve().parent
 SOURCES = (HERE / "rotorub_kernel.c",)
 HEADER = HERE / "rotorub_kernel.h"
-ABI_VERSION = 3
+ABI_VERSION = 4
 LAW_WIDTH = 7
 OUT_BLADE_BLOCKS = 6
 OUT_GLOBALS = 8
@@ -133,6 +133,11 @@ def _declare(lib: ctypes.CDLL) -> ctypes.CDLL:
     lib.rr_cd_build.argtypes = [ctypes.c_int, *[_dp] * 8, ctypes.c_double, ctypes.c_double, ctypes.c_double,
                                 _dp, _dp, _dp, _dp, _ip]
     lib.rr_cd_build.restype = ctypes.c_int
+    lib.rr_static_work_size.argtypes = [ctypes.c_int]
+    lib.rr_static_work_size.restype = ctypes.c_int
+    lib.rr_static_solve.argtypes = [ctypes.POINTER(RRContact), _dp, _dp, _dp, ctypes.c_double, ctypes.c_int, _dp,
+                                    ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_int), _dp, _ip]
+    lib.rr_static_solve.restype = ctypes.c_int
     lib.rr_blade_law.argtypes = [ctypes.c_int, ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_double,
                                  _dp]
     lib.rr_laws.argtypes = [c, _dp, _dp, _dp]

@@ -42,7 +42,7 @@ extern "C" {
 #endif
 
 /* Bumped whenever a struct layout or a signature below changes. */
-#define RR_ABI_VERSION 3
+#define RR_ABI_VERSION 4
 
 /* Per-blade law values (rr_laws): F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction. */
 #define RR_LAW_WIDTH 7
@@ -212,6 +212,20 @@ RR_API int rr_inverse(int n, const double *A, double *Ainv, double *work, int *p
  * form, Francis double-shift QR (no eigenvectors); work: n doubles. Returns 0, or -1 if the QR
  * iteration did not converge. */
 RR_API int rr_eigenvalues(int n, double *A, double *wr, double *wi, double *work);
+
+/* ------------------------------------------------------------------ balanced static solutions */
+/* Doubles and ints of scratch rr_static_solve needs. */
+RR_API int rr_static_work_size(int n);
+/* Balanced static solution of K q = F_nl(q) + F (eq. 10), K the stiffness K(Omega): Newton with
+ * the analytic contact Jacobian, LU, and a backtracking line search on |R|, tried from a list of
+ * starts until one converges (|R| <= tol |F|): q0 (if not NULL), the linear response, the
+ * responses with every contact closed at full, half and a tenth of its stiffness, the linear
+ * response scaled by 0.5, 0.25, 1.5, 2; then a continuation in the imbalance from 0 in ten steps.
+ * If none converges, q is the start with the smallest residual. Returns 1 (converged) or 0;
+ * *residual = |R| / |F|, *iterations = Newton iterations in all. work: rr_static_work_size(n)
+ * doubles, iwork: n ints. The contact's work buffer is used too. */
+RR_API int rr_static_solve(const rr_contact *c, const double *K, const double *F, const double *q0, double tol,
+                           int max_iter, double *q, double *residual, int *iterations, double *work, int *iwork);
 
 /* The central-difference matrices at spin speed omega, angular acceleration omega_dot and step dt,
  * assembled in the library's order of operations: C = D + omega G1,
