@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import ast
 import hashlib
-import html
 import json
 import shutil
 import sys
@@ -38,9 +37,12 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 SCRIPT = HERE / "rotorub_casing_contact.py"
+INTERFACE = HERE / "interface.py"
 import rotorub_model  # noqa: E402 - the sources that travel inside the FMU, wherever they are installed
 
 LIB = Path(rotorub_model.__file__).resolve().parent
+from . import interface  # noqa: E402
+
 MODEL_IDENTIFIER = "RotorCasingContact"
 HOST_REQUIREMENTS = ["numpy>=1.26"]
 # scipy is needed only to assemble a model from a param_file other than the one built in
@@ -75,64 +77,23 @@ def _check_relative_only(path: Path, text: str) -> str:
     return text
 
 
-def _documentation(doc: Path, manifest: dict, variables: list[tuple]) -> None:
+PYTHONFMU_HOST = """<p>This is a <a href="https://github.com/NTNU-IHB/PythonFMU">pythonfmu</a> FMU: its binary
+embeds the host's CPython and does <b>not</b> link libpython.</p>
+<ul><li>CPython 3.10 or newer, 64-bit, with <b>numpy</b> importable (resources/requirements.txt). That is all for
+the model built in; scipy too if <code>param_file</code> names another parameter file. The compiled kernel
+travels in resources/ (linux64, and win64 when it was cross-compiled).</li>
+<li>A Python master (fmpy, libcosimpy, ...) in that Python: nothing else. A native master: preload the shared
+libpython and set PYTHONHOME / PYTHONPATH (docs/FMU-hosts.md in the repository), or use the native FMU.</li></ul>"""
+PYTHONFMU_LIMITS = """<li>pythonfmu can return only fmi2OK, fmi2Discard (from fmi2DoStep) and fmi2Fatal (an
+exception): a misuse the native FMU refuses with fmi2Error at the call (out-of-range value, setting an output,
+a bad configuration or FMU state) is logged here and refused at the next fmi2DoStep, with fmi2Discard.</li>"""
+
+
+def _documentation(doc: Path, variables: list) -> None:
     doc.mkdir(parents=True, exist_ok=True)
-    rows = "\n".join(
-        f"<tr><td><code>{html.escape(n)}</code></td><td>{c}</td><td>{html.escape(u or '')}</td>"
-        f"<td>{html.escape(d)}</td></tr>"
-        for n, _k, c, _v, u, d in variables
-    )
-    req = "".join(f"<li><code>{html.escape(r)}</code></li>" for r in HOST_REQUIREMENTS)
-    (doc / "index.html").write_text(f"""<!DOCTYPE html>
-<html><head><meta charset="utf-8"><title>{MODEL_IDENTIFIER}</title></head><body>
-<h1>{MODEL_IDENTIFIER} &mdash; blade-tip / casing contact FMU (FMI 2.0 co-simulation)</h1>
-<p>Bladed fan rotor and flexible casing in the rotating frame (Parent, Thouverez &amp; Chevillot,
-EURODYN 2014), wrapped from the <code>rotorub_model</code> library {html.escape(manifest['library_version'])}
-whose sources travel inside the FMU (<code>resources/{html.escape(manifest['library'])}</code>), with the
-parameter file <code>resources/{html.escape(manifest['parameters'])}</code> ({manifest['n_blades']} blades).</p>
-<h2>What the host needs</h2>
-<p>This is a <a href="https://github.com/NTNU-IHB/PythonFMU">pythonfmu</a> FMU: its shared library embeds
-the CPython interpreter of the host and does <b>not</b> link libpython.</p>
-<ul>
-<li>CPython 3.10 or newer, 64-bit (Linux: a shared <code>libpython3.X.so</code>), with these packages
-importable ({html.escape('resources/requirements.txt')}; <code>pythonfmu deploy</code> installs them):
-<ul>{req}</ul>
-numba is required: the bundled library compiles its contact law and transient loop with it (first step of a
-process: a few seconds of JIT compilation, cached next to the extracted sources when writable).
-pythonfmu itself is carried in <code>resources/pythonfmu</code>; rotorub does not need to be installed.</li>
-<li>A Python master (fmpy, ecospy, ...) running in that Python: nothing else to do.</li>
-<li>A native master (C/C++ system simulator): load <code>libpython3.X.so</code> with
-<code>RTLD_GLOBAL</code> before the FMU's <code>binaries/linux64/{MODEL_IDENTIFIER}.so</code> (e.g.
-<code>LD_PRELOAD=/path/to/libpython3.11.so</code>), and set <code>PYTHONHOME</code> to the Python's
-prefix and <code>PYTHONPATH</code> to the site-packages holding numpy, scipy, numba (e.g. a virtualenv's).
-See docs/FMU.md in the repository for a worked example.</li>
-</ul>
-<h2>Behaviour</h2>
-<ul>
-<li>Inputs are held constant over each communication step (zero-order hold; no input interpolation).
-Variable communication step sizes are accepted.</li>
-<li><code>mode = "transient"</code>: central differences; each step h is split into n = ceil(h / dt_cap)
-equal substeps, dt_cap = min(dt_max, half the stability limit 2/w_max at the current speed). When h/n
-changes, the scheme restarts at the same velocity.</li>
-<li><code>mode = "quasi_static"</code>: each step returns the balanced static solution at the current inputs,
-warm-started from the previous one, and the largest real part of the linearised eigenvalues.</li>
-<li>fmi2GetFMUstate / fmi2SetFMUstate / serialization restore the full solver state (rollback);
-fmi2Reset returns to the instantiated state.</li>
-<li>Bad input (NaN or negative spin speed or imbalance, unknown mode or formulation, dt_max &lt;= 0,
-unreadable parameter file) and divergence make fmi2DoStep return fmi2Discard after a log message
-(status fmi2Error or fmi2Discard) that names the cause; the <code>status</code> output says 2 (bad input)
-or 1 (diverged). The instance stays usable: corrected inputs, fmi2SetFMUstate or fmi2Reset.</li>
-</ul>
-<h2>Variables</h2>
-<table border="1" cellspacing="0" cellpadding="3">
-<tr><th>name</th><th>causality</th><th>unit</th><th>description</th></tr>
-{rows}
-</table>
-</body></html>
-""")
-    fmu_md = HERE / "FMU.md"
-    if fmu_md.exists():
-        shutil.copy2(fmu_md, doc / "FMU.md")
+    (doc / "index.html").write_text(interface.documentation_html(variables, "pythonfmu", PYTHONFMU_HOST,
+                                                                 PYTHONFMU_LIMITS))
+    shutil.copy2(HERE / "FMU.md", doc / "FMU.md")
 
 
 def _kernel_binaries(pkg: Path, platforms: tuple[str, ...] | None) -> list[str]:
@@ -171,11 +132,13 @@ def _kernel_binaries(pkg: Path, platforms: tuple[str, ...] | None) -> list[str]:
 
 
 def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
-              platforms: tuple[str, ...] | None = None) -> dict:
+              platforms: tuple[str, ...] | None = None, mode: str = "transient") -> dict:
     """Build ``dest/RotorCasingContact.fmu``; returns a summary dict. Needs pythonfmu.
 
     ``platforms``: FMI platforms to compile the kernel for (default: this one, plus win64 when
-    ziglang is installed).
+    ziglang is installed). ``mode``: the default of the ``mode`` parameter and what the model
+    description declares ('transient': no output depends directly on an input;
+    'quasi_static': the outputs follow Omega and imbalance, direct feedthrough).
     """
     try:
         from pythonfmu import FmuBuilder
@@ -193,15 +156,20 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
 
     files = _library_files()
     h = hashlib.sha256()
-    for p in [SCRIPT, params_path, *files]:
+    if mode not in ("transient", "quasi_static"):
+        raise BuildError(f"mode: '{mode}' unknown; accepted: transient, quasi_static")
+    for p in [SCRIPT, INTERFACE, params_path, *files]:
         h.update(str(p.relative_to(LIB) if p.is_relative_to(LIB) else p.name).encode())
         h.update(p.read_bytes())
     h.update(pythonfmu_version.encode())
+    h.update(mode.encode())
     tag = h.hexdigest()[:10]
     lib_name = f"rotorub_model_{tag}"
     module_name = f"rotorub_casing_contact_{tag}"
+    interface_name = f"rotorub_fmu_interface_{tag}"
     manifest = {"library": lib_name, "library_version": lib_version, "parameters": "reference.toml",
-                "model": "model.npz", "n_blades": params.blades.count, "build": tag,
+                "model": "model.npz", "interface": interface_name, "mode": mode,
+                "feedthrough": mode == "quasi_static", "n_blades": params.blades.count, "build": tag,
                 "pythonfmu": pythonfmu_version, "host_requirements": HOST_REQUIREMENTS,
                 "optional_requirements": OPTIONAL_REQUIREMENTS}
 
@@ -221,20 +189,23 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
             else:
                 shutil.copy2(p, out)
         shutil.copy2(params_path, stage / "reference.toml")
-        save_model(build_model(params), stage / "model.npz")
+        model = build_model(params)
+        save_model(model, stage / "model.npz")
+        manifest["n_dofs"] = model.n_dofs
+        shutil.copy2(INTERFACE, stage / f"{interface_name}.py")
         manifest["kernel_platforms"] = _kernel_binaries(pkg, platforms)
         (stage / "rotorub_fmu.json").write_text(json.dumps(manifest, indent=1))
         (stage / "requirements.txt").write_text("\n".join(HOST_REQUIREMENTS) + "\n")
         script = stage / f"{module_name}.py"
         shutil.copy2(SCRIPT, script)
-        spec_vars = _variables(stage, module_name)
-        _documentation(Path(tmp) / "documentation", manifest, spec_vars)
+        _documentation(Path(tmp) / "documentation",
+                       interface.variables(interface.Defaults.from_parameters(params), mode))
         out_file = dest / f"{MODEL_IDENTIFIER}.fmu"
         try:
             FmuBuilder.build_FMU(
                 script, dest=out_file,
                 project_files=[pkg, stage / "reference.toml", stage / "model.npz", stage / "rotorub_fmu.json",
-                               stage / "requirements.txt"],
+                               stage / "requirements.txt", stage / f"{interface_name}.py"],
                 documentation_folder=Path(tmp) / "documentation",
                 canGetAndSetFMUstate=True, canSerializeFMUstate=True,
             )
@@ -243,7 +214,7 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
             # and leaves its folders on sys.path: undo that, the folders are about to disappear
             added_modules = set(sys.modules) - before
             for m in added_modules:
-                if m.split(".")[0] in (module_name, lib_name, f"_doc_{module_name}"):
+                if m.split(".")[0] in (module_name, lib_name, interface_name, f"_doc_{module_name}"):
                     sys.modules.pop(m, None)
             sys.path[:] = path_before
     with zipfile.ZipFile(out_file) as z:
@@ -253,21 +224,6 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
             "variables": md.count("<ScalarVariable"), "blades": params.blades.count, "build": tag,
             "parameters": str(params_path), "host_requirements": HOST_REQUIREMENTS,
             "kernel_platforms": manifest["kernel_platforms"]}
-
-
-def _variables(stage: Path, module_name: str) -> list[tuple]:
-    """The variable table of the slave (for the documentation), read by instantiating it."""
-    import importlib.util
-
-    sys.path.insert(0, str(stage))
-    try:
-        spec = importlib.util.spec_from_file_location(f"_doc_{module_name}", stage / f"{module_name}.py")
-        mod = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(mod)
-        inst = mod.RotorCasingContact(instance_name="doc", resources=str(stage))
-        return list(inst._specs)
-    finally:
-        sys.path.remove(str(stage))
 
 
 def main(argv: list[str] | None = None) -> int:

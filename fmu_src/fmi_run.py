@@ -24,6 +24,7 @@ Example
 
 from __future__ import annotations
 
+import hashlib
 import shutil
 from collections.abc import Iterable, Sequence
 from pathlib import Path
@@ -64,6 +65,8 @@ def simulate(fmu: str | Path, **kwargs) -> np.ndarray:
 
     log = _Log()
     kwargs.setdefault("debug_logging", True)
+    if kwargs.get("start_values"):
+        kwargs["start_values"] = enum_values(fmu, kwargs["start_values"])
     try:
         result = simulate_fmu(str(fmu), logger=log, **kwargs)
     except Exception as exc:  # noqa: BLE001 - re-raised with the FMU's own words
@@ -73,6 +76,22 @@ def simulate(fmu: str | Path, **kwargs) -> np.ndarray:
         t = float(result["time"][-1]) if len(result) else float("nan")
         raise FMUError(f"simulation stopped at t = {t:g} s", refused)
     return result
+
+
+def enum_values(fmu: str | Path, values: dict) -> dict:
+    """``values`` with Enumeration items given by name replaced by their values (fmpy takes integers)."""
+    from fmpy import read_model_description
+
+    variables = {v.name: v for v in read_model_description(str(fmu)).modelVariables}
+    out = dict(values)
+    for name, value in values.items():
+        v = variables.get(name)
+        if v is not None and v.type == "Enumeration" and isinstance(value, str):
+            items = {it.name: int(it.value) for it in v.declaredType.items}
+            if value not in items:
+                raise KeyError(f"{name}: '{value}' is not one of its items ({', '.join(items)})")
+            out[name] = items[value]
+    return out
 
 
 class Slave:
@@ -114,6 +133,7 @@ class Slave:
         self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=self.unzip_dir,
                              modelIdentifier=md.coSimulation.modelIdentifier, instanceName=instance_name)
         self._alive = False
+        self._blob_times: dict[bytes, float] = {}
         self._call("fmi2Instantiate", self.fmu.instantiate, callbacks=cb, loggingOn=True)
         self._alive = True
         self.time = start_time
@@ -148,18 +168,31 @@ class Slave:
 
     # -- values
     def set(self, **values) -> None:
-        """Set variables by name (Real, Integer, Boolean, String by their declared type)."""
+        """Set variables by name (Real, Integer, Boolean, String by their declared type; an Enumeration
+        by its item name or its value)."""
         for name, value in values.items():
             v = self._vr(name)
+            if v.type == "Enumeration" and isinstance(value, str):
+                value = self.enum_value(name, value)
             fn = {"Real": self.fmu.setReal, "Integer": self.fmu.setInteger, "Enumeration": self.fmu.setInteger,
                   "Boolean": self.fmu.setBoolean, "String": self.fmu.setString}[v.type]
             self._call(f"set {name}", fn, [v.valueReference], [value])
 
+    def enum_value(self, name: str, item: str) -> int:
+        """The value of an Enumeration variable's item, by name."""
+        items = {it.name: int(it.value) for it in self._vr(name).declaredType.items}
+        if item not in items:
+            raise KeyError(f"{name}: '{item}' is not one of its items ({', '.join(items)})")
+        return items[item]
+
     def get(self, name: str):
+        """A variable's value (an Enumeration's as its item name)."""
         v = self._vr(name)
         fn = {"Real": self.fmu.getReal, "Integer": self.fmu.getInteger, "Enumeration": self.fmu.getInteger,
               "Boolean": self.fmu.getBoolean, "String": self.fmu.getString}[v.type]
         out = self._call(f"get {name}", fn, [v.valueReference])[0]
+        if v.type == "Enumeration":
+            return next((it.name for it in v.declaredType.items if int(it.value) == out), out)
         return out.decode() if isinstance(out, bytes) else out
 
     def get_reals(self, names: Iterable[str]) -> np.ndarray:
@@ -186,10 +219,14 @@ class Slave:
         self._call("fmi2FreeFMUstate", self.fmu.freeFMUState, state[0])
 
     def serialize(self, state) -> bytes:
-        return bytes(self._call("fmi2SerializeFMUstate", self.fmu.serializeFMUState, state[0]))
+        data = bytes(self._call("fmi2SerializeFMUstate", self.fmu.serializeFMUState, state[0]))
+        self._blob_times[hashlib.sha1(data).digest()] = state[1]  # the FMU's time is in the bytes, not in reach
+        return data
 
     def deserialize(self, data: bytes):
-        return self._call("fmi2DeSerializeFMUstate", self.fmu.deserializeFMUState, data), self.time
+        """(state, its time): the time recorded when these bytes were serialized here, else the current one."""
+        t = self._blob_times.get(hashlib.sha1(bytes(data)).digest(), self.time)
+        return self._call("fmi2DeSerializeFMUstate", self.fmu.deserializeFMUState, data), t
 
     def reset(self) -> None:
         self._call("fmi2Reset", self.fmu.reset)
@@ -213,4 +250,4 @@ class Slave:
         self.close()
 
 
-__all__ = ["FMUError", "Slave", "simulate"]
+__all__ = ["FMUError", "Slave", "enum_values", "simulate"]

@@ -294,3 +294,38 @@ def xml_bytes(root: Element) -> bytes:
     from xml.dom import minidom
 
     return minidom.parseString(tostring(root, encoding="utf-8")).toprettyxml(indent="  ", encoding="UTF-8")
+
+
+def documentation_html(vars_: list[Var], flavour: str, host_needs: str, details: str) -> str:
+    """documentation/index.html of an FMU: what it is, what the host needs, the variables."""
+    import html
+
+    rows = "\n".join(
+        f"<tr><td><code>{html.escape(v.name)}</code></td><td>{v.causality}</td><td>{html.escape(v.unit or '')}"
+        f"{' (' + v.display_unit + ')' if v.display_unit else ''}</td>"
+        f"<td>{'' if v.min is None else f'[{v.min:g}, {v.max:g}]'}</td><td>{html.escape(v.description)}</td></tr>"
+        for v in vars_)
+    return f"""<!DOCTYPE html>
+<html><head><meta charset="utf-8"><title>{MODEL_IDENTIFIER} ({flavour})</title></head><body>
+<h1>{MODEL_IDENTIFIER} &mdash; blade-tip / casing contact, FMI 2.0 co-simulation ({flavour})</h1>
+<p>{html.escape(DESCRIPTION)}</p>
+<h2>What the host needs</h2>
+{host_needs}
+<h2>Behaviour</h2>
+<ul>
+<li>Inputs are held over each communication step (zero-order hold); variable step sizes are accepted. A step h
+is n = ceil(h / min(dt_max, half the central-difference stability limit)) equal substeps (transient mode).</li>
+<li>quasi_static mode: the balanced static solution at the held inputs and the largest real part of the
+eigenvalues of the linearised system; status 3 when it is unstable.</li>
+<li>fmi2Get/SetFMUstate and their serialisation restore the whole solver state (rollback); fmi2Reset returns to
+the instantiated state.</li>
+<li>{STATUS_TEXT}</li>
+{details}
+</ul>
+<p>The manual: <code>documentation/FMU.md</code>.</p>
+<h2>Variables</h2>
+<table border="1" cellspacing="0" cellpadding="3">
+<tr><th>name</th><th>causality</th><th>unit (display)</th><th>range</th><th>description</th></tr>
+{rows}
+</table></body></html>
+"""

@@ -67,9 +67,9 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
         "branch are counted in harnesses.quasi_static.vs_library)")
 
     try:
-        from .engine import run_coupled_scenario
+        from .coupling import run_coupled_scenario
     except ImportError as exc:  # the engine coupling is part of the package; say so if it is broken
-        raise RuntimeError(f"fmu_src.engine is not importable: {exc}") from exc
+        raise RuntimeError(f"fmu_src.coupling is not importable: {exc}") from exc
     _step("coupled engine scenario: LP spool FMU + contact FMU, fmpy master loop, SSP file")
     coupled = run_coupled_scenario(out / "coupled", quick=quick, contact_fmu=fmu, fmu_dir=fmu_dir)
     res["coupled_run"] = coupled

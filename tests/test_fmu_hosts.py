@@ -1,15 +1,16 @@
-"""RotorCasingContact.fmu outside fmpy: a native C host and OSP libcosim (libcosimpy).
+"""Both flavours of RotorCasingContact.fmu outside fmpy: a native C host and OSP libcosim (libcosimpy).
 
 * fmu_src/native_host/fmu_host.c, compiled with gcc, is a master that is not Python: it dlopens the FMU's
-  binaries/linux64/RotorCasingContact.so and calls the FMI 2.0 functions itself. The FMU is a pythonfmu one,
-  so the host process gets libpython (LD_PRELOAD, or the host's -L option: dlopen RTLD_GLOBAL) and
-  PYTHONHOME / PYTHONPATH (see docs/FMU-hosts.md).
+  binaries/linux64/RotorCasingContact.so and calls the FMI 2.0 functions itself. The native FMU needs nothing
+  else (the host's environment has no Python in it); the pythonfmu one needs libpython (LD_PRELOAD, or the
+  host's -L option: dlopen RTLD_GLOBAL) and PYTHONHOME / PYTHONPATH (see docs/FMU-hosts.md).
 * libcosimpy (the Python binding of the Open Simulation Platform's libcosim, a C++ co-simulation master) loads
   the .fmu file itself, steps it with its own fixed-step algorithm and observers.
 
 Both must reproduce an fmpy run of the same scenario (same parameters, inputs held over each step) to 1e-12
-relative: the slave does the same arithmetic whatever the master. A bad input (Omega = -1) must be refused with
-fmi2Discard and a logged message naming Omega, and the native host must shut the instance down cleanly.
+relative: the slave does the same arithmetic whatever the master. A bad input (Omega = -1) must be refused (the
+native FMU with fmi2Error at the fmi2SetReal that sets it, the pythonfmu one with fmi2Discard at the next step)
+with a logged message naming Omega, and the host must shut the instance down cleanly.
 """
 
 from __future__ import annotations
@@ -33,16 +34,23 @@ N_BLADES = 10
 # a short transient run with contact from the first steps (3D, reference model, 0.2 mm clearance)
 SCENARIO = {"formulation": "3D", "mode": "transient", "g0": 0.2e-3, "Omega": 176.2, "imbalance": 0.022,
             "steps": 200, "h": 1e-3}
+MODE, FORMULATION = 1, 2  # the Enumeration values of transient and 3D
 RTOL = 1e-12
 FMI2_OK, FMI2_DISCARD = 0, 2
+FMI2_ERROR = 3
 STATUS_BAD_INPUT = 2  # the FMU's `status` output
 
 
 # ---------------------------------------------------------------------------------------------- fixtures
+@pytest.fixture(scope="module", params=["pythonfmu", "native"])
+def flavour(request) -> str:
+    return request.param
+
+
 @pytest.fixture(scope="module")
-def fmu(contact_fmu) -> Path:
-    """The FMU built from the working tree (conftest)."""
-    return Path(contact_fmu)
+def fmu(flavour, request) -> Path:
+    """The FMU of this flavour built from the working tree (conftest)."""
+    return Path(request.getfixturevalue("contact_fmu" if flavour == "pythonfmu" else "native_fmu"))
 
 
 @pytest.fixture(scope="module")
@@ -87,7 +95,7 @@ def reference(fmu_dir, md) -> dict:
     s.instantiate(loggingOn=False)
     s.setupExperiment(startTime=0.0)
     s.setReal([_vr(md, "g0", "Real")], [sc["g0"]])
-    s.setString([_vr(md, "mode", "String"), _vr(md, "formulation", "String")], [sc["mode"], sc["formulation"]])
+    s.setInteger([_vr(md, "mode", "Enumeration"), _vr(md, "formulation", "Enumeration")], [MODE, FORMULATION])
     s.setReal(inputs, u)
     s.enterInitializationMode()
     s.exitInitializationMode()
@@ -143,9 +151,14 @@ def host(tmp_path_factory) -> Path:
     return exe
 
 
-def _host_env(preload: Path | None) -> dict:
-    """What a native host process needs for this FMU: Python's home, the folder of numpy, libpython."""
-    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONSTARTUP", "PYTHONHOME", "PYTHONPATH")}
+def _host_env(preload: Path | None, python: bool = True) -> dict:
+    """What a native host process needs for a pythonfmu FMU: Python's home, the folder of numpy, libpython.
+    ``python=False``: an environment with no trace of Python (what the native FMU runs in)."""
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("PYTHONSTARTUP", "PYTHONHOME", "PYTHONPATH", "LD_PRELOAD", "VIRTUAL_ENV")}
+    if not python:
+        env["PATH"] = "/usr/bin:/bin"
+        return env
     env["PYTHONHOME"] = sys.base_prefix
     env["PYTHONPATH"] = str(Path(np.__file__).resolve().parents[1])
     if preload is not None:
@@ -155,15 +168,15 @@ def _host_env(preload: Path | None) -> dict:
     return env
 
 
-def _run_host(host: Path, fmu_dir: Path, md: dict, *, omega: float, steps: int, preload: bool = True,
+def _run_host(host: Path, fmu_dir: Path, md: dict, flavour: str, *, omega: float, steps: int, preload: bool = True,
               events: tuple[str, ...] = ()) -> tuple[subprocess.CompletedProcess, list[str], np.ndarray]:
     """Run the C host on SCENARIO (with Omega, steps, events changed); returns (process, header, rows)."""
     sc = SCENARIO
-    libpython = _libpython()
+    libpython = _libpython() if flavour == "pythonfmu" else None
     args = [str(host), "-d", str(fmu_dir), "-m", MODEL, "-n", str(steps), "-s", repr(sc["h"]),
             "-p", f"{_vr(md, 'g0', 'Real')}={sc['g0']!r}",
-            "-S", f"{_vr(md, 'mode', 'String')}={sc['mode']}",
-            "-S", f"{_vr(md, 'formulation', 'String')}={sc['formulation']}",
+            "-I", f"{_vr(md, 'mode', 'Enumeration')}={MODE}",
+            "-I", f"{_vr(md, 'formulation', 'Enumeration')}={FORMULATION}",
             "-u", f"{_vr(md, 'Omega', 'Real')}={omega!r}",
             "-u", f"{_vr(md, 'imbalance', 'Real')}={sc['imbalance']!r}"]
     for e in events:
@@ -171,10 +184,10 @@ def _run_host(host: Path, fmu_dir: Path, md: dict, *, omega: float, steps: int, 
     for name in _fn_names():
         args += ["-o", str(_vr(md, name, "Real"))]
     args += ["-i", str(_vr(md, "status", "Integer")), "-i", str(_vr(md, "n_contact", "Integer"))]
-    if not preload:  # the other way: the host dlopens libpython with RTLD_GLOBAL itself
+    if libpython and not preload:  # the other way: the host dlopens libpython with RTLD_GLOBAL itself
         args += ["-L", str(libpython)]
-    proc = subprocess.run(args, capture_output=True, text=True, timeout=180,
-                          env=_host_env(libpython if preload else None))
+    env = _host_env(libpython if preload else None, python=libpython is not None)
+    proc = subprocess.run(args, capture_output=True, text=True, timeout=180, env=env)
     lines = proc.stdout.strip().splitlines()
     header = lines[0].split(",") if lines else []
     rows = np.array([[float(x) if x else np.nan for x in ln.split(",")] for ln in lines[1:]])
@@ -185,9 +198,10 @@ def _explain(proc: subprocess.CompletedProcess) -> str:
     return f"exit status {proc.returncode}\n--- stdout\n{proc.stdout[-3000:]}\n--- stderr\n{proc.stderr[-3000:]}"
 
 
-def test_c_host_matches_fmpy(host, fmu_dir, md, reference):
-    """The C host (libpython by LD_PRELOAD) runs the scenario: every step fmi2OK, F_N as fmpy's to 1e-12."""
-    proc, header, rows = _run_host(host, fmu_dir, md, omega=SCENARIO["Omega"], steps=SCENARIO["steps"])
+def test_c_host_matches_fmpy(host, fmu_dir, md, reference, flavour):
+    """The C host runs the scenario (pythonfmu: libpython by LD_PRELOAD; native: no Python anywhere in the
+    host's environment): every step fmi2OK, F_N as fmpy's to 1e-12."""
+    proc, header, rows = _run_host(host, fmu_dir, md, flavour, omega=SCENARIO["Omega"], steps=SCENARIO["steps"])
     assert proc.returncode == 0, _explain(proc)
     assert "fmu_host: done, exit status 0" in proc.stderr
     n_u = 2
@@ -207,26 +221,40 @@ def test_c_host_matches_fmpy(host, fmu_dir, md, reference):
 
 
 @pytest.mark.parametrize("case", ["from_start", "mid_run"])
-def test_c_host_bad_input(host, fmu_dir, md, reference, case):
-    """Omega = -1 (from the first step, or from step 50 on, in contact): fmi2DoStep returns fmi2Discard, the log
-    names Omega, the `status` output says 2 (bad input), the host terminates, frees the instance, exits normally.
-    This run loads libpython with the host's -L option (dlopen RTLD_GLOBAL) instead of LD_PRELOAD."""
+def test_c_host_bad_input(host, fmu_dir, md, reference, flavour, case):
+    """Omega = -1 (from the start, or from step 50 on, in contact), outside the declared range [0, Omega_max]:
+    the native FMU refuses it at fmi2SetReal with fmi2Error; the pythonfmu one (which can return only OK, Discard
+    or Fatal) logs it at the fmi2SetReal and refuses the next fmi2DoStep with fmi2Discard. Either way the log
+    names Omega and the range, the `status` output says 2 (bad input), the state is unchanged and the host shuts
+    the instance down and exits normally. The pythonfmu run loads libpython with the host's -L option."""
     omega_vr = _vr(md, "Omega", "Real")
     k_bad = 0 if case == "from_start" else 50
     if case == "from_start":
-        proc, header, rows = _run_host(host, fmu_dir, md, omega=-1.0, steps=3, preload=False)
+        proc, header, rows = _run_host(host, fmu_dir, md, flavour, omega=-1.0, steps=3, preload=False)
     else:
-        proc, header, rows = _run_host(host, fmu_dir, md, omega=SCENARIO["Omega"], steps=55, preload=False,
-                                       events=(f"{k_bad}:{omega_vr}=-1",))
+        proc, header, rows = _run_host(host, fmu_dir, md, flavour, omega=SCENARIO["Omega"], steps=55,
+                                       preload=False, events=(f"{k_bad}:{omega_vr}=-1",))
+    logged = [ln for ln in proc.stderr.splitlines() if ln.startswith("[log] ")]
+    refusal = [ln for ln in logged if "Omega" in ln]
+    assert refusal, _explain(proc)
+    assert refusal[0].startswith("[log] host fmi2Error ") and "-1" in refusal[0] and "accepted range" in refusal[0]
+    if flavour == "native" and case == "from_start":
+        # refused before initialization: the host reports it and exits without stepping
+        assert proc.returncode == 1 and "initialization returned fmi2Error" in proc.stderr, _explain(proc)
+        return
+    if flavour == "native":
+        assert proc.returncode == 3, _explain(proc)
+        assert "fmi2SetReal before the step at t = 0.05" in proc.stderr and "returned fmi2Error" in proc.stderr
+        assert rows.shape[0] == k_bad + 1  # the initialization row and the good steps: the bad value never got in
+        F = rows[:, 4:4 + N_BLADES]
+        np.testing.assert_array_equal(F, reference["F_N"][:k_bad + 1])
+        assert "fmu_host: done, exit status 3" in proc.stderr
+        return
     assert proc.returncode == 3, _explain(proc)  # 3: a step was refused and the host shut down cleanly
     stop = [ln for ln in proc.stderr.splitlines() if ln.startswith("fmu_host: fmi2DoStep(")]
     assert len(stop) == 1 and stop[0].endswith(" returned fmi2Discard; stopping"), _explain(proc)
     assert float(stop[0].split("(")[1].split(",")[0]) == pytest.approx(k_bad * SCENARIO["h"], abs=1e-15)
     assert "fmu_host: done, exit status 3" in proc.stderr
-    logged = [ln for ln in proc.stderr.splitlines() if ln.startswith("[log] ")]
-    refusal = [ln for ln in logged if "Omega" in ln]
-    assert refusal, _explain(proc)
-    assert refusal[0].startswith("[log] host fmi2Error ") and "-1" in refusal[0] and "step refused" in refusal[0]
     assert rows.shape[0] == k_bad + 2  # initialization row, the good steps, the refused one
     assert (rows[:-1, 1] == FMI2_OK).all()
     assert rows[-1, 1] == FMI2_DISCARD  # what pythonfmu returns when do_step says False (never fmi2Error)
@@ -239,11 +267,20 @@ def test_c_host_bad_input(host, fmu_dir, md, reference, case):
     np.testing.assert_array_equal(F[-1], F[-2])
 
 
-def test_c_host_without_libpython(host, fmu_dir):
-    """Without libpython the FMU's library cannot be loaded: the host says so and how to fix it (no crash)."""
-    env = _host_env(None)
+def test_c_host_without_libpython(host, fmu_dir, flavour):
+    """pythonfmu: without libpython the FMU's library cannot be loaded: the host says so and how to fix it (no
+    crash). native: it needs no libpython, and links nothing but the C runtime and libm (ldd)."""
+    env = _host_env(None, python=False)
     proc = subprocess.run([str(host), "-d", str(fmu_dir), "-n", "1"], capture_output=True, text=True, timeout=60,
                           env=env)
+    if flavour == "native":
+        assert proc.returncode == 0, _explain(proc)
+        ldd = subprocess.run(["ldd", str(fmu_dir / "binaries" / "linux64" / f"{MODEL}.so")], capture_output=True,
+                             text=True).stdout
+        libs = {ln.split()[0] for ln in ldd.splitlines() if ln.strip()}
+        assert libs <= {"linux-vdso.so.1", "libm.so.6", "libc.so.6", "/lib64/ld-linux-x86-64.so.2"}, ldd
+        assert "libm.so.6" in libs and "libc.so.6" in libs and not any("python" in x for x in libs), ldd
+        return
     assert proc.returncode == 1, _explain(proc)
     assert "undefined symbol" in proc.stderr and "LD_PRELOAD" in proc.stderr
 
@@ -277,8 +314,9 @@ def _run_libcosim(fmu: Path, md: dict, omega: float, steps: int) -> tuple[np.nda
     assert ex.add_observer(observer) and ex.add_manipulator(manipulator)
     inputs = [_vr(md, "Omega", "Real"), _vr(md, "imbalance", "Real")]
     u = [omega, sc["imbalance"]]
-    assert ex.string_initial_value(i, _vr(md, "mode", "String"), sc["mode"])
-    assert ex.string_initial_value(i, _vr(md, "formulation", "String"), sc["formulation"])
+    # libcosim 0.0.6 ignores Enumeration variables ("FMI 2.0 Enumeration variable type not supported"): mode and
+    # formulation keep their defaults, which are the scenario's (transient, 3D); docs/FMU-hosts.md says so
+    assert (MODE, FORMULATION) == (1, 2)
     assert ex.real_initial_value(i, _vr(md, "g0", "Real"), sc["g0"])
     for vr, v in zip(inputs, u):
         assert ex.real_initial_value(i, vr, v)
@@ -311,33 +349,47 @@ _LIBCOSIM_BAD_INPUT = """
 import sys
 from libcosimpy.CosimExecution import CosimExecution
 from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+from libcosimpy.CosimManipulator import CosimManipulator
 from libcosimpy.CosimSlave import CosimLocalSlave
 
-fmu, omega_vr = sys.argv[1], int(sys.argv[2])
+fmu, omega_vr, at_start = sys.argv[1], int(sys.argv[2]), sys.argv[3] == "start"
 log_output_level(CosimLogLevel.WARNING)
 ex = CosimExecution.from_step_size(1_000_000)
 slave = CosimLocalSlave(fmu_path=fmu, instance_name="rotor")
 i = ex.add_local_slave(slave)
-assert ex.real_initial_value(i, omega_vr, -1.0)
+manipulator = CosimManipulator.create_override()
+assert ex.add_manipulator(manipulator)
+assert ex.real_initial_value(i, omega_vr, -1.0 if at_start else 150.0)
+if not at_start:
+    print("good steps:", ex.step(5))
+    assert manipulator.slave_real_values(i, [omega_vr], [-1.0])
 print("step ok:", ex.step(1))
 print("state:", ex.status().state)
-del ex, slave
+del ex, manipulator, slave
 """
 
 
-def test_libcosim_bad_input(fmu, md):
-    """Omega = -1 through libcosim: the step fails (the FMU returned fmi2Discard, which libcosim takes as an error),
-    the execution is in its error state, and the FMU's message naming Omega is in libcosim's log. In a separate
-    process: libcosim logs to stdout through a buffered C++ stream, flushed at exit, so capfd would miss it."""
+@pytest.mark.parametrize("when", ["start", "mid_run"])
+def test_libcosim_bad_input(fmu, md, flavour, when):
+    """Omega = -1 through libcosim, as an initial value or set by a manipulator mid-run: the FMU refuses it and
+    its message naming Omega and the range is in libcosim's log. Mid-run, or from the pythonfmu FMU (which can
+    only refuse the step, with fmi2Discard), libcosim's step fails and the execution is in its error state.
+    At initialisation, the native FMU's fmi2Error from fmi2SetReal (the standard's answer to a value outside the
+    declared range) makes libcosim 0.0.6 throw from a worker thread and end the process: a limitation of that
+    master, documented in docs/FMU-hosts.md (check initial values against the declared ranges first).
+    In a separate process: libcosim logs to stdout through a buffered C++ stream, flushed at exit."""
     _libcosim()
     from libcosimpy.CosimEnums import CosimExecutionState
 
-    proc = subprocess.run([sys.executable, "-c", _LIBCOSIM_BAD_INPUT, str(fmu), str(_vr(md, "Omega", "Real"))],
+    proc = subprocess.run([sys.executable, "-c", _LIBCOSIM_BAD_INPUT, str(fmu), str(_vr(md, "Omega", "Real")), when],
                           capture_output=True, text=True, timeout=120)
+    refusal = [ln for ln in (proc.stdout + proc.stderr).splitlines() if "Omega" in ln and "-1" in ln]
+    assert refusal, _explain(proc)
+    assert "[error]" in refusal[0] and "FMI status=error" in refusal[0] and "accepted range" in refusal[0]
+    if flavour == "native" and when == "start":
+        assert proc.returncode != 0 and "terminate called after throwing an instance of 'cosim::error'" in \
+            proc.stderr, _explain(proc)
+        return
     assert proc.returncode == 0, _explain(proc)
     assert "step ok: False" in proc.stdout, _explain(proc)
     assert f"state: {CosimExecutionState.ERROR.value}" in proc.stdout, _explain(proc)
-    refusal = [ln for ln in (proc.stdout + proc.stderr).splitlines() if "Omega" in ln]
-    assert refusal, _explain(proc)
-    assert "[error]" in refusal[0] and "FMI status=error" in refusal[0] and "-1" in refusal[0] \
-        and "step refused" in refusal[0]

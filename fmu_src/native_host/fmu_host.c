@@ -9,7 +9,7 @@
  *   gcc -O2 -Wall -o fmu_host fmu_host.c -ldl
  *
  *   fmu_host -d DIR [-m MODEL] [-L LIBPYTHON] [-n STEPS] [-s STEP] [-t START] [-q]
- *            [-p VR=REAL]... [-S VR=STRING]... [-u VR=V0[:V1]]... [-e K:VR=REAL]...
+ *            [-p VR=REAL]... [-I VR=INT]... [-S VR=STRING]... [-u VR=V0[:V1]]... [-e K:VR=REAL]...
  *            [-o VR]... [-i VR]...
  *
  *   -d DIR        folder the .fmu was unzipped into (holds modelDescription.xml)
@@ -20,6 +20,7 @@
  *   -s STEP       communication step size in s (default 1e-3)
  *   -t START      start time in s (default 0)
  *   -p VR=REAL    fmi2SetReal before fmi2EnterInitializationMode (parameters, start values)
+ *   -I VR=INT     fmi2SetInteger before fmi2EnterInitializationMode (Integer, Enumeration)
  *   -S VR=STRING  fmi2SetString before fmi2EnterInitializationMode
  *   -u VR=V0[:V1] real input set before every fmi2DoStep and held over the step:
  *                 V0 + (V1 - V0) * k / (STEPS - 1) at step k = 0..STEPS-1 (V0 if V1 omitted)
@@ -91,6 +92,7 @@ typedef fmi2Status (*fmi2ExitInitializationModeTYPE)(fmi2Component);
 typedef fmi2Status (*fmi2TerminateTYPE)(fmi2Component);
 typedef fmi2Status (*fmi2SetRealTYPE)(fmi2Component, const fmi2ValueReference[], size_t, const fmi2Real[]);
 typedef fmi2Status (*fmi2SetStringTYPE)(fmi2Component, const fmi2ValueReference[], size_t, const fmi2String[]);
+typedef fmi2Status (*fmi2SetIntegerTYPE)(fmi2Component, const fmi2ValueReference[], size_t, const fmi2Integer[]);
 typedef fmi2Status (*fmi2GetRealTYPE)(fmi2Component, const fmi2ValueReference[], size_t, fmi2Real[]);
 typedef fmi2Status (*fmi2GetIntegerTYPE)(fmi2Component, const fmi2ValueReference[], size_t, fmi2Integer[]);
 typedef fmi2Status (*fmi2DoStepTYPE)(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean);
@@ -105,6 +107,7 @@ static struct {
     fmi2TerminateTYPE Terminate;
     fmi2SetRealTYPE SetReal;
     fmi2SetStringTYPE SetString;
+    fmi2SetIntegerTYPE SetInteger;
     fmi2GetRealTYPE GetReal;
     fmi2GetIntegerTYPE GetInteger;
     fmi2DoStepTYPE DoStep;
@@ -144,7 +147,8 @@ typedef struct { fmi2ValueReference vr; const char *value; } StrParam;
 static void usage(const char *msg)
 {
     fprintf(stderr, "fmu_host: %s\nusage: fmu_host -d DIR [-m MODEL] [-L LIBPYTHON] [-n STEPS] [-s STEP] [-t START] "
-                    "[-q] [-p VR=REAL]... [-S VR=STRING]... [-u VR=V0[:V1]]... [-e K:VR=REAL]... [-o VR]... [-i VR]...\n",
+                    "[-q] [-p VR=REAL]... [-I VR=INT]... [-S VR=STRING]... [-u VR=V0[:V1]]... [-e K:VR=REAL]... [-o VR]... "
+                    "[-i VR]...\n",
             msg);
     exit(2);
 }
@@ -253,12 +257,13 @@ int main(int argc, char **argv)
     long steps = 10;
     double h = 1e-3, t0 = 0.0;
     int logging_on = fmi2True;
-    static fmi2ValueReference pr_vr[MAX_VARS], out_r[MAX_VARS], out_i[MAX_VARS];
+    static fmi2ValueReference pr_vr[MAX_VARS], pi_vr[MAX_VARS], out_r[MAX_VARS], out_i[MAX_VARS];
     static double pr_val[MAX_VARS];
+    static fmi2Integer pi_val[MAX_VARS];
     static StrParam ps[MAX_VARS];
     static Input in[MAX_VARS];
     static Event ev[MAX_VARS];
-    size_t npr = 0, nps = 0, nin = 0, nev = 0, nor = 0, noi = 0;
+    size_t npr = 0, npi = 0, nps = 0, nin = 0, nev = 0, nor = 0, noi = 0;
 
     for (int a = 1; a < argc; a++) {
         const char *opt = argv[a];
@@ -269,7 +274,7 @@ int main(int argc, char **argv)
         }
         if (a + 1 >= argc) usage("missing option value");
         char *val = argv[++a], *rest;
-        if (npr >= MAX_VARS || nps >= MAX_VARS || nin >= MAX_VARS || nev >= MAX_VARS || nor >= MAX_VARS ||
+        if (npr >= MAX_VARS || npi >= MAX_VARS || nps >= MAX_VARS || nin >= MAX_VARS || nev >= MAX_VARS || nor >= MAX_VARS ||
             noi >= MAX_VARS)
             usage("too many variables");
         switch (opt[1]) {
@@ -282,6 +287,10 @@ int main(int argc, char **argv)
         case 'p':
             pr_vr[npr] = parse_vr_assign(val, &rest, "-p");
             pr_val[npr++] = parse_double(rest, "-p");
+            break;
+        case 'I':
+            pi_vr[npi] = parse_vr_assign(val, &rest, "-I");
+            pi_val[npi++] = (fmi2Integer)parse_long(rest, "-I");
             break;
         case 'S':
             ps[nps].vr = parse_vr_assign(val, &rest, "-S");
@@ -339,6 +348,7 @@ int main(int argc, char **argv)
     fmi.Terminate = (fmi2TerminateTYPE)resolve(lib, "fmi2Terminate");
     fmi.SetReal = (fmi2SetRealTYPE)resolve(lib, "fmi2SetReal");
     fmi.SetString = (fmi2SetStringTYPE)resolve(lib, "fmi2SetString");
+    fmi.SetInteger = (fmi2SetIntegerTYPE)resolve(lib, "fmi2SetInteger");
     fmi.GetReal = (fmi2GetRealTYPE)resolve(lib, "fmi2GetReal");
     fmi.GetInteger = (fmi2GetIntegerTYPE)resolve(lib, "fmi2GetInteger");
     fmi.DoStep = (fmi2DoStepTYPE)resolve(lib, "fmi2DoStep");
@@ -366,6 +376,7 @@ int main(int argc, char **argv)
     /* 3. parameters and start values, initialization */
     fmi2Status st = fmi.SetupExperiment(c, fmi2False, 0.0, t0, fmi2False, 0.0);
     for (size_t i = 0; i < npr; i++) st = worst(st, fmi.SetReal(c, &pr_vr[i], 1, &pr_val[i]));
+    for (size_t i = 0; i < npi; i++) st = worst(st, fmi.SetInteger(c, &pi_vr[i], 1, &pi_val[i]));
     for (size_t i = 0; i < nps; i++) st = worst(st, fmi.SetString(c, &ps[i].vr, 1, &ps[i].value));
     double *u = calloc(nin + 1, sizeof *u);
     for (size_t i = 0; i < nin; i++) {

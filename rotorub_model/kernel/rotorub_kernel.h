@@ -29,16 +29,20 @@
 extern "C" {
 #endif
 
-#if defined(_WIN32)
-#  if defined(RR_BUILD_SHARED)
-#    define RR_API __declspec(dllexport)
+/* Exported from the kernel's own shared library; an FMU that compiles the kernel in defines
+ * RR_API empty so that only its fmi2 functions are visible. */
+#ifndef RR_API
+#  if defined(_WIN32)
+#    if defined(RR_BUILD_SHARED)
+#      define RR_API __declspec(dllexport)
+#    else
+#      define RR_API
+#    endif
+#  elif defined(__GNUC__)
+#    define RR_API __attribute__((visibility("default")))
 #  else
 #    define RR_API
 #  endif
-#elif defined(__GNUC__)
-#  define RR_API __attribute__((visibility("default")))
-#else
-#  define RR_API
 #endif
 
 /* Bumped whenever a struct layout or a signature below changes. */

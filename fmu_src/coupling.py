@@ -1,8 +1,9 @@
 """Engine coupling: the LP spool's speed as a second FMU, the coupled system as an SSP, an fmpy master.
 
-    python -m fmu_src.engine OUT_DIR [--full] [--contact-fmu F] [--spool-fmu F]
+    python -m fmu_src.coupling OUT_DIR [--full] [--contact-fmu F] [--spool-fmu F]
 
-Pieces:
+This module is the master loop and the scenario; the spool FMU is fmu_src/spool.py's, the SSP
+package fmu_src/ssp.py's, what they share fmu_src/system.py's. Pieces:
 
 * :func:`build_spool_fmu` builds ``LPSpool.fmu`` from fmu_src/spool_slave.py with
   pythonfmu (same recipe as fmu_src/build.py: the script is staged under a hashed
@@ -27,7 +28,7 @@ Pieces:
   step; the friction torque recorded at t_k is exactly what the spool integrated over
   [t_k, t_k + h], which is what the angular-momentum balance below uses.
 * :func:`run_coupled_scenario`: the run-up through the first critical speed with the
-  reference imbalance, without rub (g0 = 1 m: no contact) and with rub (g0 = 1 mm),
+  reference imbalance, without rub (g0 = 50 mm: no contact) and with rub (g0 = 1 mm),
   saved as NPZ, a PNG and summary.json next to the SSP.
 
 Balance (CoupledResult.momentum_balance): the drive torque is a schedule in time, the
@@ -45,431 +46,31 @@ impulse (tests/test_engine.py states the tolerance).
 from __future__ import annotations
 
 import argparse
-import hashlib
-import io
 import json
 import math
 import sys
-import tempfile
 import time
-import zipfile
 from dataclasses import dataclass, field
-from functools import cache
 from pathlib import Path
-from xml.etree import ElementTree as ET
 
 import numpy as np
 
 from rotorub_model.results import pyplot, save_figure, write_json
 
 from .fmi_run import FMUError, Slave
-
-HERE = Path(__file__).resolve().parent
-SPOOL_SCRIPT = HERE / "spool_slave.py"
-SCHEMA_DIR = HERE / "schemas" / "ssp1"
-SPOOL_ID = "LPSpool"
-CONTACT_ID = "RotorCasingContact"
-OMEGA_REF = 53.4  # rad/s, normalisation speed of the reference parameters
-FIRST_CRITICAL = 3.49 * OMEGA_REF  # rad/s, first critical speed of the reference model (about 186.4 rad/s)
-
-NS = {
-    "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
-    "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon",
-    "ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
-}
-MASTER_NS = "urn:rotorub:ssp:master"  # our annotation (communication step and exchange order)
-for _p, _u in NS.items():
-    ET.register_namespace(_p, _u)
-ET.register_namespace("rotorub", MASTER_NS)
-
-# the connections of the coupled system: (start element, start connector, end element, end connector)
-CONNECTIONS = (("spool", "Omega", "contact", "Omega"), ("contact", "friction_torque", "spool", "friction_torque"))
-# scenario: reference imbalance, reference clearance, rub disabled by a 1 m clearance
-ME_REF = 22.0e-3  # kg m
-G0_RUB = 1.0e-3  # m
-G0_NO_RUB = 1.0  # m
-
-
-class EngineError(RuntimeError):
-    """A build, SSP or co-simulation problem; ``messages`` holds what the FMUs logged."""
-
-    def __init__(self, what: str, messages=(), result=None):
-        self.messages = list(messages)
-        self.result = result  # the CoupledResult up to the failure, if any
-        detail = ("; ".join(self.messages)) if self.messages else ""
-        super().__init__(f"{what}: {detail}" if detail else what)
-
-
-# ---------------------------------------------------------------------------------------------- building
-def spool_defaults() -> dict:
-    """The spool FMU's default parameter values (module defaults of fmu_src/spool_slave.py)."""
-    from . import spool_slave
-
-    return dict(spool_slave.DEFAULTS)
-
-
-def build_spool_fmu(dest: str | Path = "fmus", **defaults) -> Path:
-    """Build ``dest/LPSpool.fmu``; keyword arguments override the parameters' start values
-    (J, c_w, Omega0, Omega1, t_ramp_start, t_ramp, dt_max). Needs pythonfmu."""
-    try:
-        from pythonfmu import FmuBuilder
-        from pythonfmu import __version__ as pythonfmu_version
-    except ImportError:
-        raise EngineError("pythonfmu is not installed: pip install 'rotorub[fmu]'") from None
-    values = spool_defaults()
-    unknown = sorted(set(defaults) - set(values))
-    if unknown:
-        raise EngineError(f"build_spool_fmu: unknown parameter(s) {', '.join(unknown)}; known: {', '.join(values)}")
-    for k, v in defaults.items():
-        v = float(v)
-        if not math.isfinite(v):
-            raise EngineError(f"build_spool_fmu: {k} = {v!r} is not finite")
-        values[k] = v
-    script_bytes = SPOOL_SCRIPT.read_bytes()
-    tag = hashlib.sha256(script_bytes + pythonfmu_version.encode()).hexdigest()[:10]
-    module_name = f"lpspool_{tag}"
-    dest = Path(dest)
-    dest.mkdir(parents=True, exist_ok=True)
-    out_file = dest / f"{SPOOL_ID}.fmu"
-    before = set(sys.modules)
-    path_before = list(sys.path)
-    with tempfile.TemporaryDirectory(prefix="rotorub_spool_") as tmp:
-        stage = Path(tmp) / "stage"
-        stage.mkdir()
-        script = stage / f"{module_name}.py"
-        script.write_bytes(script_bytes)
-        defaults_file = stage / "lpspool_defaults.json"
-        defaults_file.write_text(json.dumps(values, indent=1))
-        doc = Path(tmp) / "documentation"
-        doc.mkdir()
-        rows = "\n".join(f"<tr><td><code>{k}</code></td><td>{v!r}</td></tr>" for k, v in values.items())
-        (doc / "index.html").write_text(
-            "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>LPSpool</title></head><body>\n"
-            "<h1>LPSpool &mdash; low-pressure spool speed (FMI 2.0 co-simulation, pythonfmu)</h1>\n"
-            "<p>J dOmega/dt = tau_drive(t) - c_w Omega<sup>2</sup> + friction_torque. The drive torque schedule "
-            "tau_drive = J dOmega_s/dt + c_w Omega_s<sup>2</sup> makes the spool follow the half-cosine speed "
-            "schedule Omega_s(t) (Omega0 until t_ramp_start, Omega1 after t_ramp_start + t_ramp) exactly when no "
-            "external torque acts. Integration: RK4 on e = Omega - Omega_s with ceil(h/dt_max) substeps per "
-            "communication step, friction_torque held (zero-order hold). Rollback: fmi2Get/SetFMUstate and "
-            "serialization. Bad parameters or inputs: fmi2DoStep returns fmi2Discard after a log message naming "
-            "the variable (log with loggingOn = true).</p>\n<p>Needs a CPython 3.10+ host (pythonfmu); no other "
-            f"package.</p>\n<h2>Parameter start values</h2><table border=\"1\">\n{rows}\n</table></body></html>\n")
-        try:
-            FmuBuilder.build_FMU(script, dest=out_file, project_files=[defaults_file], documentation_folder=doc,
-                                 canGetAndSetFMUstate=True, canSerializeFMUstate=True)
-        finally:
-            for m in set(sys.modules) - before:
-                if m.split(".")[0] == module_name:
-                    sys.modules.pop(m, None)
-            sys.path[:] = path_before
-    return out_file
-
-
-def build_contact_fmu(dest: str | Path = "fmus") -> Path:
-    """``RotorCasingContact.fmu`` from fmu_src/build.py (reference parameters)."""
-    from .build import build_fmu
-
-    return Path(build_fmu(dest)["fmu"])
-
-
-# ---------------------------------------------------------------------------------------------- FMU descriptions
-@dataclass(frozen=True)
-class _Var:
-    name: str
-    type: str  # Real, Integer, Boolean, String, Enumeration
-    causality: str
-    variability: str
-    unit: str | None
-    start: str | None
-
-
-def _read_description(source) -> tuple[dict[str, _Var], dict[str, dict[str, float]], ET.Element]:
-    """(variables by name, unit name -> base-unit exponents, root) of an FMU file, FMU bytes or folder."""
-    if isinstance(source, bytes | bytearray):
-        with zipfile.ZipFile(io.BytesIO(source)) as z:
-            xml = z.read("modelDescription.xml")
-    else:
-        p = Path(source)
-        if p.is_dir():
-            xml = (p / "modelDescription.xml").read_bytes()
-        else:
-            with zipfile.ZipFile(p) as z:
-                xml = z.read("modelDescription.xml")
-    root = ET.fromstring(xml)
-    variables = {}
-    for sv in root.iter("ScalarVariable"):
-        typ = next(iter(sv))
-        variables[sv.get("name")] = _Var(sv.get("name"), typ.tag, sv.get("causality", "local"),
-                                         sv.get("variability", "continuous"), typ.get("unit"), typ.get("start"))
-    units = {}
-    for u in root.iter("Unit"):
-        bu = u.find("BaseUnit")
-        units[u.get("name")] = {} if bu is None else {k: float(v) for k, v in bu.attrib.items()}
-    return variables, units, root
-
-
-# ---------------------------------------------------------------------------------------------- SSP
-def _q(prefix: str, tag: str) -> str:
-    return f"{{{NS[prefix]}}}{tag}"
-
-
-def _fmt(v: float) -> str:
-    return repr(float(v))  # shortest round-tripping decimal: a valid xs:double
-
-
-def _connector(parent: ET.Element, var: _Var, kind: str) -> None:
-    c = ET.SubElement(parent, _q("ssd", "Connector"), name=var.name, kind=kind)
-    attrs = {"unit": var.unit} if (var.type == "Real" and var.unit) else {}
-    ET.SubElement(c, _q("ssc", var.type if var.type in ("Real", "Integer", "Boolean", "String") else "Real"), attrs)
-
-
-def _parameter_set(name: str, values: dict, variables: dict[str, _Var], units: dict) -> bytes:
-    root = ET.Element(_q("ssv", "ParameterSet"), version="1.0", name=name)
-    params = ET.SubElement(root, _q("ssv", "Parameters"))
-    used_units = []
-    for pname, value in values.items():
-        var = variables[pname]
-        p = ET.SubElement(params, _q("ssv", "Parameter"), name=pname)
-        if var.type == "String":
-            ET.SubElement(p, _q("ssv", "String"), value=str(value))
-        elif var.type == "Integer":
-            ET.SubElement(p, _q("ssv", "Integer"), value=str(int(value)))
-        else:
-            attrs = {"value": _fmt(value)}
-            if var.unit:
-                attrs["unit"] = var.unit
-                if var.unit not in used_units:
-                    used_units.append(var.unit)
-            ET.SubElement(p, _q("ssv", "Real"), attrs)
-    if used_units:
-        _units(ET.SubElement(root, _q("ssv", "Units")), used_units, units)
-    return _xml_bytes(root)
-
-
-def _units(parent: ET.Element, names, units: dict) -> None:
-    for name in names:
-        u = ET.SubElement(parent, _q("ssc", "Unit"), name=name)
-        exps = units.get(name, {})
-        ET.SubElement(u, _q("ssc", "BaseUnit"), {k: (str(int(v)) if k not in ("factor", "offset") else _fmt(v))
-                                                 for k, v in exps.items() if v != 0 or k == "factor"})
-
-
-def _xml_bytes(root: ET.Element) -> bytes:
-    ET.indent(root)
-    return b'<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="utf-8") + b"\n"
-
-
-def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, *, g0: float = G0_RUB,
-              imbalance: float = ME_REF, formulation: str = "3D", mode: str = "transient",
-              spool_params: dict | None = None, contact_params: dict | None = None, t_end: float = 5.0,
-              h: float = 1e-3, name: str = "RotorRubEngine") -> Path:
-    """Write the coupled system as an SSP 1.0 package; returns its path.
-
-    The package holds ``SystemStructure.ssd``, ``resources/RotorCasingContact.fmu``,
-    ``resources/LPSpool.fmu`` and the parameter sets ``resources/contact.ssv`` (g0,
-    formulation, mode, the imbalance input's value, ``contact_params``) and
-    ``resources/spool.ssv`` (the spool FMU's parameter start values updated by
-    ``spool_params``). The communication step and the exchange order of
-    :func:`run_coupled` are recorded in an annotation of the default experiment.
-    """
-    path = Path(path)
-    cvars, cunits, _ = _read_description(contact_fmu)
-    svars, sunits, _ = _read_description(spool_fmu)
-    all_units = {**sunits, **cunits}
-    for el, conn, _e, _c in CONNECTIONS:
-        vars_ = cvars if el == "contact" else svars
-        if conn not in vars_:
-            raise EngineError(f"write_ssp: the {el} FMU has no variable '{conn}'")
-    spool_values = {k: float(v.start) for k, v in svars.items() if v.causality == "parameter"}
-    for k, v in (spool_params or {}).items():
-        if k not in spool_values:
-            raise EngineError(f"write_ssp: spool parameter '{k}' unknown; known: {', '.join(spool_values)}")
-        spool_values[k] = float(v)
-    contact_values = {"g0": float(g0), "formulation": str(formulation), "mode": str(mode),
-                      "imbalance": float(imbalance)}
-    for k, v in (contact_params or {}).items():
-        if k not in cvars or cvars[k].causality not in ("parameter", "input"):
-            raise EngineError(f"write_ssp: contact parameter '{k}' is not a parameter or input of the contact FMU")
-        contact_values[k] = v
-
-    root = ET.Element(_q("ssd", "SystemStructureDescription"), version="1.0", name=name,
-                      description="Low-pressure spool of a turbofan coupled with the blade-tip/casing contact of its "
-                                  "fan: the spool's speed drives the contact model, the contact's friction torque "
-                                  "brakes the spool",
-                      generationTool="rotorub fmu_src.engine")
-    system = ET.SubElement(root, _q("ssd", "System"), name=name)
-    elements = ET.SubElement(system, _q("ssd", "Elements"))
-    comps = (
-        ("contact", f"resources/{CONTACT_ID}.fmu", cvars, contact_values,
-         [("Omega", "input"), ("imbalance", "input"), ("friction_torque", "output"), ("n_contact", "output"),
-          ("gap_min", "output")]),
-        ("spool", f"resources/{SPOOL_ID}.fmu", svars, spool_values,
-         [("friction_torque", "input"), ("Omega", "output"), ("drive_torque", "output"),
-          ("windage_torque", "output")]),
-    )
-    for cname, source, vars_, pvalues, conns in comps:
-        comp = ET.SubElement(elements, _q("ssd", "Component"), name=cname, type="application/x-fmu-sharedlibrary",
-                             source=source, implementation="CoSimulation")
-        connectors = ET.SubElement(comp, _q("ssd", "Connectors"))
-        declared = set()
-        for vname, kind in conns:
-            if vname in vars_:
-                _connector(connectors, vars_[vname], kind)
-                declared.add(vname)
-        for vname in pvalues:
-            if vname not in declared:
-                _connector(connectors, vars_[vname], "parameter" if vars_[vname].causality == "parameter" else "input")
-                declared.add(vname)
-        bindings = ET.SubElement(comp, _q("ssd", "ParameterBindings"))
-        ET.SubElement(bindings, _q("ssd", "ParameterBinding"), type="application/x-ssp-parameter-set",
-                      source=f"resources/{cname}.ssv")
-    connections = ET.SubElement(system, _q("ssd", "Connections"))
-    for se, sc, ee, ec in CONNECTIONS:
-        ET.SubElement(connections, _q("ssd", "Connection"), startElement=se, startConnector=sc, endElement=ee,
-                      endConnector=ec)
-    used = []
-    for _c, _s, vars_, pvalues, conns in comps:
-        for vname in [c for c, _k in conns] + list(pvalues):
-            u = vars_[vname].unit if vname in vars_ else None
-            if u and u not in used:
-                used.append(u)
-    _units(ET.SubElement(root, _q("ssd", "Units")), used, all_units)
-    de = ET.SubElement(root, _q("ssd", "DefaultExperiment"), startTime="0.0", stopTime=_fmt(t_end))
-    ann = ET.SubElement(ET.SubElement(de, _q("ssd", "Annotations")), _q("ssc", "Annotation"),
-                        type="org.rotorub.master")
-    ET.SubElement(ann, f"{{{MASTER_NS}}}FixedStepMaster", stepSize=_fmt(h), exchange="Jacobi",
-                  description="fixed communication step; at each communication point both FMUs get the other's "
-                              "outputs at that point, then both step (inputs held over the step)")
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
-        z.writestr("SystemStructure.ssd", _xml_bytes(root))
-        z.write(contact_fmu, f"resources/{CONTACT_ID}.fmu")
-        z.write(spool_fmu, f"resources/{SPOOL_ID}.fmu")
-        z.writestr("resources/contact.ssv", _parameter_set("contact", contact_values, cvars, all_units))
-        z.writestr("resources/spool.ssv", _parameter_set("spool", spool_values, svars, all_units))
-    return path
-
-
-@cache
-def _schema(name: str):
-    from lxml import etree
-
-    return etree.XMLSchema(etree.parse(str(SCHEMA_DIR / name)))
-
-
-def _schema_problems(xml: bytes, schema_file: str, where: str) -> tuple[list[str], object]:
-    from lxml import etree
-
-    try:
-        doc = etree.fromstring(xml)
-    except etree.XMLSyntaxError as exc:
-        return [f"{where}: not well-formed XML ({exc})"], None
-    schema = _schema(schema_file)
-    if schema.validate(doc):
-        return [], doc
-    return [f"{where}:{e.line}: {e.message}" for e in schema.error_log], doc
-
-
-def validate_ssp(path: str | Path) -> list[str]:
-    """Problems of an SSP package (empty list: valid).
-
-    Checks ``SystemStructure.ssd`` against the SSP 1.0 SystemStructureDescription
-    schema and every ``.ssv`` parameter set it binds against the
-    SystemStructureParameterValues schema (XML Schema 1.0, lxml), then that each
-    component's FMU is in the package, that its connectors exist in the FMU with a
-    compatible causality, that connections join declared connectors from an output
-    to an input, and that every bound parameter names a variable of the FMU.
-    """
-    problems: list[str] = []
-    try:
-        z = zipfile.ZipFile(path)
-    except (OSError, zipfile.BadZipFile) as exc:
-        return [f"{path}: not a readable zip file ({exc})"]
-    with z:
-        names = set(z.namelist())
-        if "SystemStructure.ssd" not in names:
-            return [f"{path}: SystemStructure.ssd missing (the default SSD of an SSP)"]
-        for n in sorted(names):
-            if n.endswith(".ssd") and n != "SystemStructure.ssd":  # variant SSDs
-                p, _ = _schema_problems(z.read(n), "SystemStructureDescription.xsd", n)
-                problems += p
-        p, doc = _schema_problems(z.read("SystemStructure.ssd"), "SystemStructureDescription.xsd",
-                                  "SystemStructure.ssd")
-        problems += p
-        if doc is None:
-            return problems
-        ns = {"ssd": NS["ssd"], "ssc": NS["ssc"], "ssv": NS["ssv"]}
-        connectors: dict[tuple[str, str], str] = {}
-        for sys_el in doc.iter(_q("ssd", "System")):
-            for c in sys_el.findall("ssd:Connectors/ssd:Connector", ns):
-                connectors[("", c.get("name"))] = c.get("kind")
-        for comp in doc.iter(_q("ssd", "Component")):
-            cname, src = comp.get("name"), comp.get("source")
-            if comp.get("type", "application/x-fmu-sharedlibrary") != "application/x-fmu-sharedlibrary":
-                continue
-            if src not in names:
-                problems.append(f"component '{cname}': source '{src}' is not in the package")
-                continue
-            try:
-                fvars, _, _ = _read_description(z.read(src))
-            except Exception as exc:  # noqa: BLE001 - reported
-                problems.append(f"component '{cname}': {src} is not a readable FMU ({exc})")
-                continue
-            for c in comp.findall("ssd:Connectors/ssd:Connector", ns):
-                vname, kind = c.get("name"), c.get("kind")
-                connectors[(cname, vname)] = kind
-                var = fvars.get(vname)
-                if var is None:
-                    problems.append(f"component '{cname}': connector '{vname}' is not a variable of {src}")
-                elif kind != var.causality:
-                    problems.append(f"component '{cname}': connector '{vname}' has kind '{kind}' but the FMU's "
-                                    f"variable has causality '{var.causality}'")
-            for b in comp.findall("ssd:ParameterBindings/ssd:ParameterBinding", ns):
-                bsrc = b.get("source")
-                if bsrc is None:
-                    sets = b.findall("ssd:ParameterValues/ssv:ParameterSet", ns)
-                    xmls = [ET.tostring(s) for s in sets]
-                else:
-                    if bsrc not in names:
-                        problems.append(f"component '{cname}': parameter set '{bsrc}' is not in the package")
-                        continue
-                    xmls = [z.read(bsrc)]
-                for xml in xmls:
-                    p, sdoc = _schema_problems(xml, "SystemStructureParameterValues.xsd", bsrc or "inline ssv")
-                    problems += p
-                    if sdoc is None:
-                        continue
-                    for par in sdoc.iter(_q("ssv", "Parameter")):
-                        pname = par.get("name")
-                        var = fvars.get(pname)
-                        if var is None or var.causality not in ("parameter", "input"):
-                            problems.append(f"component '{cname}': {bsrc or 'inline ssv'} sets '{pname}', which is "
-                                            f"not a parameter or input of {src}")
-        for con in doc.iter(_q("ssd", "Connection")):
-            s = (con.get("startElement") or "", con.get("startConnector"))
-            e = (con.get("endElement") or "", con.get("endConnector"))
-            for end, role, ok_kinds in ((s, "start", ("output", "parameter", "calculatedParameter", "inout")),
-                                        (e, "end", ("input", "parameter", "inout"))):
-                kind = connectors.get(end)
-                label = f"{end[0]}.{end[1]}" if end[0] else end[1]
-                if kind is None:
-                    problems.append(f"connection {s[0]}.{s[1]} -> {e[0]}.{e[1]}: {role} connector {label} is not "
-                                    "declared")
-                elif end[0] and kind not in ok_kinds:
-                    problems.append(f"connection {s[0]}.{s[1]} -> {e[0]}.{e[1]}: {role} connector {label} has kind "
-                                    f"'{kind}'")
-    return problems
-
-
-def ssp_contents(path: str | Path) -> dict:
-    """What an SSP names: {"components": {name: source}, "connections": [(se, sc, ee, ec), ...]}."""
-    with zipfile.ZipFile(path) as z:
-        root = ET.fromstring(z.read("SystemStructure.ssd"))
-    comps = {c.get("name"): c.get("source") for c in root.iter(_q("ssd", "Component"))}
-    conns = [(c.get("startElement"), c.get("startConnector"), c.get("endElement"), c.get("endConnector"))
-             for c in root.iter(_q("ssd", "Connection"))]
-    return {"components": comps, "connections": conns}
+from .spool import build_contact_fmu, build_spool_fmu, spool_defaults  # noqa: F401 - the engine system's API
+from .ssp import ssp_contents, validate_ssp, write_ssp  # noqa: F401
+from .system import (  # noqa: F401
+    CONNECTIONS,
+    CONTACT_ID,
+    FIRST_CRITICAL,
+    G0_NO_RUB,
+    G0_RUB,
+    ME_REF,
+    OMEGA_REF,
+    SPOOL_ID,
+    EngineError,
+)
 
 
 # ---------------------------------------------------------------------------------------------- master
@@ -668,7 +269,7 @@ def run_coupled(contact_fmu: str | Path, spool_fmu: str | Path, t_end: float, h:
     """Fixed-step co-simulation of the contact FMU and the spool FMU (fmpy FMU2Slave, Jacobi exchange).
 
     ``contact_fmu``/``spool_fmu``: .fmu files or extracted folders. ``g0`` [m] the
-    clearance (1 m disables the rub), ``imbalance`` [kg m] held constant, ``formulation``
+    clearance (G0_NO_RUB = 50 mm disables the rub), ``imbalance`` [kg m] held constant, ``formulation``
     '2D' or '3D' (contact mode 'transient'), ``spool_params`` the spool's parameters
     (J, c_w, Omega0, Omega1, t_ramp_start, t_ramp, dt_max), ``contact_params`` further
     contact parameters (k_r, mu, dt_max, ...). A refused step raises :class:`EngineError`

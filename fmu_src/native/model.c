@@ -1,0 +1,482 @@
+/*
+ * model.c: RotorCasingContact in C, around the rotorub kernel. The same steps as the pythonfmu
+ * slave (fmu_src/rotorub_casing_contact.py) and the library, in the same order of operations,
+ * so that the three give the same numbers:
+ *
+ *   transient     a step h is n = ceil(h / cap) kernel substeps, cap = min(dt_max, half the
+ *                 central-difference stability limit with every contact closed at Omega rounded
+ *                 up to a whole rad/s); the kernel writes every output of the final state;
+ *   quasi_static  the kernel's balanced static solution at the held inputs (warm-started from
+ *                 the last one) and the largest real part of the eigenvalues of eq. (11).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "model.h"
+
+#define RE_TOL 1e-6 /* a real part below this is a neutral mode's round-off (rotorub_model.analyses.stability) */
+#define STATE_TAG 52170301.0
+
+struct model_runtime {
+    int formulation, mode, n, nb, np;
+    double g0, k_r, mu, theta, chord, dt_max, max_pen;
+    rr_geometry geo;
+    double *geo_mem, *res_F, *res_M, *tq_F, *tq_M, *cwork;
+    rr_contact contact;
+    /* transient */
+    double *q, *qp;
+    rr_cd_state st;
+    rr_cd_matrices mats;
+    rr_cd_job job;
+    double *Ainv, *K2, *Cm1, *f, *mwork;
+    int *piv;
+    int have_mats;
+    double mats_omega, mats_dt;
+    double plan_h, plan_band, lim_band, lim;
+    int plan_n, have_plan, have_lim;
+    /* quasi-static */
+    double *qs, *Kw, *Fw, *swork, *Aeig, *Minv, *wr, *wi, *ework;
+    int *siwork;
+    int have_qs;
+    double phi_qs;
+    double advanced;
+};
+
+static void *zalloc(size_t n, size_t size) { return calloc(n ? n : 1, size); }
+
+void model_free(model_runtime *m)
+{
+    if (!m) return;
+    free(m->geo_mem);
+    free(m->q);
+    free(m->Ainv);
+    free(m->piv);
+    free(m->qs);
+    free(m->siwork);
+    free(m);
+}
+
+/* K(Omega) = K + Omega^2 (S2 + N2) + Omega C1, in the library's order of operations */
+static void k_omega(const model_data *d, double w, double *out)
+{
+    size_t i, nn = (size_t)d->n * d->n;
+    double ww = w * w;
+    for (i = 0; i < nn; ++i) out[i] = d->K[i] + ww * (d->S2[i] + d->N2[i]) + w * d->C1[i];
+}
+
+/* 2 / sqrt(max |eig(M^-1 (K(w) + Kc))|), Kc the contact stiffness with every blade in full contact */
+static double critical_step(model_runtime *m, double w)
+{
+    const model_data *d = &MODEL_DATA;
+    int n = m->n, i, j, k;
+    size_t nn = (size_t)n * n;
+    double *Kc = m->Kw, *P = m->Aeig, *J = m->swork, *zero = m->Fw, big = 0.0;
+    rr_contact closed = m->contact;
+    closed.g0 = -1.0;
+    for (i = 0; i < n; ++i) zero[i] = 0.0;
+    rr_jacobian(&closed, zero, J);
+    k_omega(d, w, Kc);
+    for (i = 0; i < (int)nn; ++i) Kc[i] = Kc[i] + -J[i];
+    for (i = 0; i < n; ++i)
+        for (j = 0; j < n; ++j) {
+            double s = 0.0;
+            for (k = 0; k < n; ++k) s += m->Minv[(size_t)i * n + k] * Kc[(size_t)k * n + j];
+            P[(size_t)i * n + j] = s;
+        }
+    if (rr_eigenvalues(n, P, m->wr, m->wi, m->ework) != 0) return -1.0;
+    for (i = 0; i < n; ++i) {
+        double a = hypot(m->wr[i], m->wi[i]);
+        if (a > big) big = a;
+    }
+    return 2.0 / sqrt(big);
+}
+
+model_runtime *model_configure(const model_values *v, char *msg, size_t len)
+{
+    const model_data *d = &MODEL_DATA;
+    model_runtime *m;
+    rr_geometry_spec spec;
+    int n = d->n, nb = d->nb, np, P;
+    size_t nn = (size_t)n * n, off = 0;
+    double *g;
+    m = (model_runtime *)zalloc(1, sizeof *m);
+    if (!m) {
+        snprintf(msg, len, "out of memory");
+        return NULL;
+    }
+    m->formulation = v->i[VR_FORMULATION];
+    m->mode = v->i[VR_MODE];
+    m->n = n;
+    m->nb = nb;
+    m->np = np = m->formulation == FORMULATION_3D ? 2 : 1;
+    P = np;
+    m->g0 = v->r[VR_G0];
+    m->k_r = v->r[VR_K_R];
+    m->mu = v->r[VR_MU];
+    /* the pythonfmu FMU hands theta to the library in degrees, which converts it back: same rounding */
+    m->theta = (v->r[VR_THETA] * (180.0 / 3.14159265358979323846)) * (3.14159265358979323846 / 180.0);
+    m->chord = v->r[VR_CHORD];
+    m->dt_max = v->r[VR_DT_MAX];
+    m->max_pen = v->r[VR_MAX_PEN];
+
+    /* contact geometry (the kernel's, from the ingredients baked at build time) */
+    m->geo_mem = (double *)zalloc((size_t)nb * P * (3 * 3 + 2 * 3 * n) + (size_t)nb * P * n + 4 * (size_t)nb * n +
+                                      2 * (size_t)n + 6 * (size_t)nb + 2 * (size_t)nb +
+                                      (size_t)rr_work_size(n, nb, np),
+                                  sizeof(double));
+    if (!m->geo_mem) goto oom;
+    g = m->geo_mem;
+#define TAKE(ptr, count) (ptr = g + off, off += (count))
+    TAKE(m->geo.points, (size_t)nb * P * 3);
+    TAKE(m->geo.normals, (size_t)nb * P * 3);
+    TAKE(m->geo.tangents, (size_t)nb * P * 3);
+    TAKE(m->geo.Jb, (size_t)nb * P * 3 * n);
+    TAKE(m->geo.Jc, (size_t)nb * P * 3 * n);
+    TAKE(m->geo.G, (size_t)nb * P * n);
+    TAKE(m->geo.A, (size_t)nb * n);
+    TAKE(m->geo.B, (size_t)nb * n);
+    TAKE(m->geo.C, (size_t)nb * n);
+    TAKE(m->geo.D, (size_t)nb * n);
+    TAKE(m->geo.T2, 2 * (size_t)n);
+    TAKE(m->res_F, 3 * (size_t)nb);
+    TAKE(m->res_M, 3 * (size_t)nb);
+    TAKE(m->tq_F, (size_t)nb);
+    TAKE(m->tq_M, (size_t)nb);
+    TAKE(m->cwork, (size_t)rr_work_size(n, nb, np));
+#undef TAKE
+    spec.n = n;
+    spec.nb = nb;
+    spec.np = np;
+    spec.rotations = 1;
+    spec.r_tip = d->r_tip;
+    spec.stagger = d->stagger;
+    spec.theta = np == 2 ? m->theta : 0.0;
+    spec.chord = np == 2 ? m->chord : 0.0;
+    spec.z_cg = d->z_cg;
+    spec.blade_dof0 = d->blade_dof0;
+    spec.n_ritz = d->n_ritz;
+    spec.psi_tip = d->psi_tip;
+    spec.casing_dof0 = d->casing_dof0;
+    spec.n_modes = d->n_modes;
+    spec.modes = d->modes;
+    spec.T = d->T;
+    spec.Rot = d->Rot;
+    if (rr_contact_geometry(&spec, &m->geo) != 0) {
+        snprintf(msg, len, "contact geometry: invalid (chord %g m)", m->chord);
+        model_free(m);
+        return NULL;
+    }
+    rr_contact_resultants(nb, np, np == 2 ? m->chord : 0.0, m->mu, m->geo.points, m->geo.normals, m->geo.tangents,
+                          m->res_F, m->res_M, m->tq_F, m->tq_M);
+    m->contact.n = n;
+    m->contact.nb = nb;
+    m->contact.np = np;
+    m->contact.g0 = m->g0;
+    m->contact.k_r = m->k_r;
+    m->contact.mu = m->mu;
+    m->contact.chord = np == 2 && m->chord > 1e-300 ? m->chord : 1e-300;
+    m->contact.G = m->geo.G;
+    m->contact.A = m->geo.A;
+    m->contact.B = m->geo.B;
+    m->contact.C = m->geo.C;
+    m->contact.D = m->geo.D;
+    m->contact.res_F = m->res_F;
+    m->contact.res_M = m->res_M;
+    m->contact.tq_F = m->tq_F;
+    m->contact.tq_M = m->tq_M;
+    m->contact.T2 = m->geo.T2;
+    m->contact.work = m->cwork;
+
+    /* integrator state and step matrices */
+    m->q = (double *)zalloc(2 * (size_t)n, sizeof(double));
+    m->Ainv = (double *)zalloc(5 * nn + (size_t)n, sizeof(double));
+    m->piv = (int *)zalloc((size_t)n, sizeof(int));
+    /* quasi-static (and the step limit): q_static, K, F, static work, the 2n x 2n matrix, M^-1, eigenvalues */
+    m->qs = (double *)zalloc((size_t)n + nn + (size_t)n + (size_t)rr_static_work_size(n) + 4 * nn + nn +
+                                 3 * 2 * (size_t)n,
+                             sizeof(double));
+    m->siwork = (int *)zalloc(2 * (size_t)n, sizeof(int));
+    if (!m->q || !m->Ainv || !m->piv || !m->qs || !m->siwork) goto oom;
+    m->qp = m->q + n;
+    m->K2 = m->Ainv + nn;
+    m->Cm1 = m->K2 + nn;
+    m->mwork = m->Cm1 + nn; /* 2 nn */
+    m->f = m->mwork + 2 * nn;
+    m->Kw = m->qs + n;
+    m->Fw = m->Kw + nn;
+    m->swork = m->Fw + n;
+    m->Aeig = m->swork + rr_static_work_size(n);
+    m->Minv = m->Aeig + 4 * nn;
+    m->wr = m->Minv + nn;
+    m->wi = m->wr + 2 * n;
+    m->ework = m->wi + 2 * n;
+    if (rr_inverse(n, d->M, m->Minv, m->Aeig, m->siwork) != 0) {
+        snprintf(msg, len, "the mass matrix is singular");
+        model_free(m);
+        return NULL;
+    }
+    m->st.t = 0.0;
+    m->st.dt = 0.0;
+    m->st.phi = 0.0;
+    m->st.max_pen = m->max_pen;
+    m->st.steps = 0;
+    m->st.diverged = 0;
+    m->st.q = m->q;
+    m->st.q_prev = m->qp;
+    m->mats.n = n;
+    m->mats.Ainv = m->Ainv;
+    m->mats.K2 = m->K2;
+    m->mats.Cm1 = m->Cm1;
+    m->mats.f = m->f;
+    m->job.state = &m->st;
+    m->job.contact = &m->contact;
+    m->job.mats = &m->mats;
+    m->job.t_ramp = 0.0;
+    m->job.rec_every = 1;
+    m->job.rec_cap = 0;
+    m->job.out_index = OUTPUT_INDEX;
+    return m;
+oom:
+    snprintf(msg, len, "out of memory");
+    model_free(m);
+    return NULL;
+}
+
+double model_time_advanced(const model_runtime *m) { return m->advanced; }
+
+static void set_clearance(model_runtime *m, double g0)
+{
+    m->g0 = g0;
+    m->contact.g0 = g0;
+}
+
+static void finish_outputs(model_values *v, double max_real)
+{
+    v->i[VR_N_CONTACT] = (int)v->r[VR_N_CONTACT];
+    v->r[VR_MAX_REAL] = max_real;
+}
+
+/* substeps of a step h at spin speed w: the step limit is evaluated once per whole rad/s */
+static int substeps(model_runtime *m, double w, double h, char *msg, size_t len)
+{
+    double band = ceil(w), cap;
+    if (m->have_plan && m->plan_h == h && m->plan_band == band) return m->plan_n;
+    if (!m->have_lim || m->lim_band != band) {
+        double lim = critical_step(m, band);
+        if (!(lim > 0.0)) {
+            snprintf(msg, len, "the central-difference stability limit could not be computed at %g rad/s", band);
+            return -1;
+        }
+        m->lim = lim;
+        m->lim_band = band;
+        m->have_lim = 1;
+    }
+    cap = m->dt_max < 0.5 * m->lim ? m->dt_max : 0.5 * m->lim;
+    m->plan_n = (int)ceil(h / cap * (1.0 - 1e-9));
+    if (m->plan_n < 1) m->plan_n = 1;
+    m->plan_h = h;
+    m->plan_band = band;
+    m->have_plan = 1;
+    return m->plan_n;
+}
+
+static fmi2Status transient_step(model_runtime *m, model_values *v, double w, double me, double h, char *msg,
+                                 size_t len)
+{
+    const model_data *d = &MODEL_DATA;
+    int n = m->n, i, ns, done;
+    double dt;
+    size_t k, nn = (size_t)n * n;
+    if (m->st.diverged) {
+        snprintf(msg, len, "the run diverged at t = %.6g s (internal time); roll back with fmi2SetFMUstate or reset "
+                 "the FMU", m->st.t);
+        return fmi2Discard;
+    }
+    ns = substeps(m, w, h, msg, len);
+    if (ns < 1) return fmi2Error;
+    dt = h / ns;
+    if (dt != m->st.dt) { /* restart the two-step scheme at the same velocity */
+        for (i = 0; i < n; ++i) {
+            double vel = (m->q[i] - m->qp[i]) / m->st.dt;
+            if (m->st.dt == 0.0) vel = 0.0; /* at rest before the first step */
+            m->qp[i] = m->q[i] - dt * vel;
+        }
+        m->st.dt = dt;
+    }
+    if (!m->have_mats || m->mats_omega != w || m->mats_dt != dt) {
+        if (rr_cd_build(n, d->M, d->D, d->K, d->G1, d->C1, d->N2, d->S2, NULL, w, 0.0, dt, m->Ainv, m->K2, m->Cm1,
+                        m->mwork, m->piv) != 0) {
+            snprintf(msg, len, "the central-difference matrix is singular at %g rad/s, dt = %g s", w, dt);
+            return fmi2Error;
+        }
+        for (k = 0; k < (size_t)n; ++k) m->f[k] = 1.0 * w * w * d->f_unit[k];
+        m->have_mats = 1;
+        m->mats_omega = w;
+        m->mats_dt = dt;
+    }
+    (void)nn;
+    m->job.n_steps = ns;
+    m->job.omega = w;
+    m->job.me = me;
+    m->job.n_rec = 0;
+    m->job.out_dest = v->r;
+    {
+        double t0 = m->st.t;
+        done = rr_cd_run(&m->job);
+        m->advanced = m->st.t - t0;
+    }
+    finish_outputs(v, 0.0);
+    v->r[VR_DT_INTERNAL] = dt;
+    v->i[VR_N_SUBSTEPS] = done;
+    if (done < ns) {
+        snprintf(msg, len, "the run diverged at t = %.6g s (internal time): a blade penetrated the casing deeper "
+                 "than max_penetration = %g mm (or the state stopped being finite); the outputs are those of that "
+                 "state; roll back with fmi2SetFMUstate or reset", m->st.t, m->max_pen * 1e3);
+        return fmi2Discard;
+    }
+    return fmi2OK;
+}
+
+/* the balanced static solution at (w, me) and its stability; outputs at frame angle phi */
+static fmi2Status static_solution(model_runtime *m, model_values *v, double w, double me, double phi, char *msg,
+                                  size_t len)
+{
+    const model_data *d = &MODEL_DATA;
+    int n = m->n, i, j, k, its, ok;
+    size_t nn = (size_t)n * n;
+    double rel, max_real = -HUGE_VAL;
+    double *q = m->Ainv; /* the transient buffers are free in this mode: the candidate solution */
+    double *J = m->K2, *A = m->Aeig, *C = m->Cm1;
+    k_omega(d, w, m->Kw);
+    for (i = 0; i < n; ++i) m->Fw[i] = me * w * w * d->f_unit[i];
+    ok = rr_static_solve(&m->contact, m->Kw, m->Fw, m->have_qs ? m->qs : NULL, 1e-10, 60, q, &rel, &its, m->swork,
+                         m->siwork);
+    if (!ok) {
+        snprintf(msg, len, "no balanced static solution at Omega = %g rad/s, imbalance = %g kg.m, g0 = %g m "
+                 "(relative residual %.2e); the outputs hold the last solution", w, me, m->g0, rel);
+        return fmi2Discard;
+    }
+    /* x' = A x, x = (q, q'): A = [[0, I], [-M^-1 (K(W) - J), -M^-1 (D + W G1)]] */
+    rr_jacobian(&m->contact, q, J);
+    for (k = 0; k < (int)nn; ++k) {
+        m->Kw[k] = m->Kw[k] - J[k];
+        C[k] = d->D[k] + w * d->G1[k];
+    }
+    for (i = 0; i < 2 * n; ++i)
+        for (j = 0; j < 2 * n; ++j) A[(size_t)i * 2 * n + j] = 0.0;
+    for (i = 0; i < n; ++i) {
+        A[(size_t)i * 2 * n + n + i] = 1.0;
+        for (j = 0; j < n; ++j) {
+            double sk = 0.0, sc = 0.0;
+            for (k = 0; k < n; ++k) {
+                double mi = m->Minv[(size_t)i * n + k];
+                sk += mi * m->Kw[(size_t)k * n + j];
+                sc += mi * C[(size_t)k * n + j];
+            }
+            A[(size_t)(n + i) * 2 * n + j] = -sk;
+            A[(size_t)(n + i) * 2 * n + n + j] = -sc;
+        }
+    }
+    if (rr_eigenvalues(2 * n, A, m->wr, m->wi, m->ework) != 0) {
+        snprintf(msg, len, "the eigenvalues of the linearised system did not converge at Omega = %g rad/s", w);
+        return fmi2Discard;
+    }
+    for (i = 0; i < 2 * n; ++i)
+        if (m->wr[i] > max_real) max_real = m->wr[i];
+    for (i = 0; i < n; ++i) m->qs[i] = q[i];
+    m->have_qs = 1;
+    rr_outputs(&m->contact, m->qs, phi, OUTPUT_INDEX, v->r);
+    finish_outputs(v, max_real);
+    v->r[VR_DT_INTERNAL] = 0.0;
+    v->i[VR_N_SUBSTEPS] = 0;
+    v->i[VR_STATUS] = max_real > RE_TOL ? STATUS_UNSTABLE : STATUS_OK;
+    return fmi2OK;
+}
+
+fmi2Status model_step(model_runtime *m, model_values *v, double h, char *msg, size_t len)
+{
+    double w = v->r[VR_OMEGA], me = v->r[VR_IMBALANCE], g0 = v->r[VR_G0];
+    fmi2Status s;
+    m->advanced = 0.0;
+    if (g0 != m->g0) set_clearance(m, g0);
+    if (m->mode == MODE_TRANSIENT) {
+        s = transient_step(m, v, w, me, h, msg, len);
+        if (s == fmi2OK) v->i[VR_STATUS] = STATUS_OK;
+        return s;
+    }
+    s = static_solution(m, v, w, me, m->phi_qs + w * h, msg, len);
+    if (s == fmi2OK) {
+        m->phi_qs += w * h;
+        m->advanced = h;
+    }
+    return s;
+}
+
+fmi2Status model_solve_now(model_runtime *m, model_values *v, char *msg, size_t len)
+{
+    double g0 = v->r[VR_G0];
+    if (g0 != m->g0) set_clearance(m, g0);
+    if (m->mode != MODE_QUASI_STATIC) {
+        /* the outputs of the current state (transient: they do not depend on the inputs) */
+        rr_outputs(&m->contact, m->q, m->st.phi, OUTPUT_INDEX, v->r);
+        finish_outputs(v, 0.0);
+        return fmi2OK;
+    }
+    return static_solution(m, v, v->r[VR_OMEGA], v->r[VR_IMBALANCE], m->phi_qs, msg, len);
+}
+
+/* ------------------------------------------------------------------ state snapshots */
+/* layout: tag, n, formulation, mode, g0, t, dt, phi, steps, diverged, have_qs, phi_qs, q, qp, qs */
+#define STATE_HEAD 12
+
+size_t model_state_size(const model_runtime *m) { return STATE_HEAD + 3 * (size_t)m->n; }
+
+void model_state_save(const model_runtime *m, double *out)
+{
+    int n = m->n, i;
+    out[0] = STATE_TAG;
+    out[1] = n;
+    out[2] = m->formulation;
+    out[3] = m->mode;
+    out[4] = m->g0;
+    out[5] = m->st.t;
+    out[6] = m->st.dt;
+    out[7] = m->st.phi;
+    out[8] = (double)m->st.steps;
+    out[9] = m->st.diverged;
+    out[10] = m->have_qs;
+    out[11] = m->phi_qs;
+    for (i = 0; i < n; ++i) {
+        out[STATE_HEAD + i] = m->q[i];
+        out[STATE_HEAD + n + i] = m->qp[i];
+        out[STATE_HEAD + 2 * n + i] = m->qs[i];
+    }
+}
+
+int model_state_restore(model_runtime *m, const double *in, size_t count)
+{
+    int n = m->n, i;
+    if (count != model_state_size(m) || in[0] != STATE_TAG || in[1] != n || in[2] != m->formulation ||
+        in[3] != m->mode || !(in[6] >= 0.0) || !(in[8] >= 0.0) || (in[9] != 0.0 && in[9] != 1.0) ||
+        (in[10] != 0.0 && in[10] != 1.0))
+        return -1;
+    for (i = 4; i < (int)count; ++i)
+        if (!isfinite(in[i])) return -1;
+    set_clearance(m, in[4]);
+    m->st.t = in[5];
+    m->st.dt = in[6];
+    m->st.phi = in[7];
+    m->st.steps = (long long)in[8];
+    m->st.diverged = (int)in[9];
+    m->have_qs = (int)in[10];
+    m->phi_qs = in[11];
+    for (i = 0; i < n; ++i) {
+        m->q[i] = in[STATE_HEAD + i];
+        m->qp[i] = in[STATE_HEAD + n + i];
+        m->qs[i] = in[STATE_HEAD + 2 * n + i];
+    }
+    m->have_mats = 0; /* dt may differ */
+    return 0;
+}

@@ -1,0 +1,323 @@
+"""The engine system as an SSP 1.0 package: writing it, validating it, and running it in OSP libcosim.
+
+* :func:`write_ssp` writes ``SystemStructure.ssd`` naming the two FMUs
+  (``resources/RotorCasingContact.fmu`` as component ``contact``, ``resources/LPSpool.fmu``
+  as ``spool``), their connections (spool.Omega -> contact.Omega, contact.friction_torque ->
+  spool.friction_torque), units, a default experiment, and one SSV parameter set per
+  component (``resources/contact.ssv``, ``resources/spool.ssv``).
+* :func:`validate_ssp` checks it against the SSP 1.0 XML schemas (vendored in
+  fmu_src/schemas/ssp1, BSD-2-Clause, see the README there) and checks that every
+  connector, connection and parameter exists in the FMUs.
+* :func:`run_ssp_libcosim` runs the package as written in libcosim
+  (``CosimExecution.from_ssp_file``): a second, independent co-simulation engine.
+"""
+
+from __future__ import annotations
+
+import zipfile
+from functools import cache
+from pathlib import Path
+from xml.etree import ElementTree as ET
+
+from .system import (
+    CONNECTIONS,
+    CONTACT_ID,
+    G0_RUB,
+    ME_REF,
+    SPOOL_ID,
+    EngineError,
+    FmuVariable,
+    enumerations,
+    read_description,
+)
+
+HERE = Path(__file__).resolve().parent
+SCHEMA_DIR = HERE / "schemas" / "ssp1"
+NS = {
+    "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
+    "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon",
+    "ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
+}
+MASTER_NS = "urn:rotorub:ssp:master"  # our annotation (communication step and exchange order)
+for _p, _u in NS.items():
+    ET.register_namespace(_p, _u)
+ET.register_namespace("rotorub", MASTER_NS)
+
+
+def _q(prefix: str, tag: str) -> str:
+    return f"{{{NS[prefix]}}}{tag}"
+
+
+def _fmt(v: float) -> str:
+    return repr(float(v))  # shortest round-tripping decimal: a valid xs:double
+
+
+def _connector(parent: ET.Element, var: FmuVariable, kind: str) -> None:
+    c = ET.SubElement(parent, _q("ssd", "Connector"), name=var.name, kind=kind)
+    attrs = {"unit": var.unit} if (var.type == "Real" and var.unit) else {}
+    if var.type == "Enumeration":
+        attrs = {"name": var.declared_type}  # declared in the SSD's Enumerations
+    ET.SubElement(c, _q("ssc", var.type if var.type in ("Real", "Integer", "Boolean", "String", "Enumeration")
+                        else "Real"), attrs)
+
+
+def _parameter_set(name: str, values: dict, variables: dict[str, FmuVariable], units: dict) -> bytes:
+    root = ET.Element(_q("ssv", "ParameterSet"), version="1.0", name=name)
+    params = ET.SubElement(root, _q("ssv", "Parameters"))
+    used_units = []
+    for pname, value in values.items():
+        var = variables[pname]
+        p = ET.SubElement(params, _q("ssv", "Parameter"), name=pname)
+        if var.type == "String":
+            ET.SubElement(p, _q("ssv", "String"), value=str(value))
+        elif var.type == "Enumeration":  # by item name (SSP 1.0: mapped to the FMU's value by the importer)
+            ET.SubElement(p, _q("ssv", "Enumeration"), value=str(value))
+        elif var.type == "Integer":
+            ET.SubElement(p, _q("ssv", "Integer"), value=str(int(value)))
+        else:
+            attrs = {"value": _fmt(value)}
+            if var.unit:
+                attrs["unit"] = var.unit
+                if var.unit not in used_units:
+                    used_units.append(var.unit)
+            ET.SubElement(p, _q("ssv", "Real"), attrs)
+    if used_units:
+        _units(ET.SubElement(root, _q("ssv", "Units")), used_units, units)
+    return _xml_bytes(root)
+
+
+def _units(parent: ET.Element, names, units: dict) -> None:
+    for name in names:
+        u = ET.SubElement(parent, _q("ssc", "Unit"), name=name)
+        exps = units.get(name, {})
+        ET.SubElement(u, _q("ssc", "BaseUnit"), {k: (str(int(v)) if k not in ("factor", "offset") else _fmt(v))
+                                                 for k, v in exps.items() if v != 0 or k == "factor"})
+
+
+def _xml_bytes(root: ET.Element) -> bytes:
+    ET.indent(root)
+    return b'<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="utf-8") + b"\n"
+
+
+def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, *, g0: float = G0_RUB,
+              imbalance: float = ME_REF, formulation: str = "3D", mode: str = "transient",
+              spool_params: dict | None = None, contact_params: dict | None = None, t_end: float = 5.0,
+              h: float = 1e-3, name: str = "RotorRubEngine") -> Path:
+    """Write the coupled system as an SSP 1.0 package; returns its path.
+
+    The package holds ``SystemStructure.ssd``, ``resources/RotorCasingContact.fmu``,
+    ``resources/LPSpool.fmu`` and the parameter sets ``resources/contact.ssv`` (g0,
+    formulation, mode, the imbalance input's value, ``contact_params``) and
+    ``resources/spool.ssv`` (the spool FMU's parameter start values updated by
+    ``spool_params``). The communication step and the exchange order of
+    :func:`run_coupled` are recorded in an annotation of the default experiment.
+    """
+    path = Path(path)
+    cvars, cunits, croot = read_description(contact_fmu)
+    svars, sunits, _ = read_description(spool_fmu)
+    all_units = {**sunits, **cunits}
+    for el, conn, _e, _c in CONNECTIONS:
+        vars_ = cvars if el == "contact" else svars
+        if conn not in vars_:
+            raise EngineError(f"write_ssp: the {el} FMU has no variable '{conn}'")
+    spool_values = {k: float(v.start) for k, v in svars.items() if v.causality == "parameter"}
+    for k, v in (spool_params or {}).items():
+        if k not in spool_values:
+            raise EngineError(f"write_ssp: spool parameter '{k}' unknown; known: {', '.join(spool_values)}")
+        spool_values[k] = float(v)
+    contact_values = {"g0": float(g0), "formulation": str(formulation), "mode": str(mode),
+                      "imbalance": float(imbalance)}
+    for k, v in (contact_params or {}).items():
+        if k not in cvars or cvars[k].causality not in ("parameter", "input"):
+            raise EngineError(f"write_ssp: contact parameter '{k}' is not a parameter or input of the contact FMU")
+        contact_values[k] = v
+
+    root = ET.Element(_q("ssd", "SystemStructureDescription"), version="1.0", name=name,
+                      description="Low-pressure spool of a turbofan coupled with the blade-tip/casing contact of its "
+                                  "fan: the spool's speed drives the contact model, the contact's friction torque "
+                                  "brakes the spool",
+                      generationTool="rotorub fmu_src.ssp")
+    system = ET.SubElement(root, _q("ssd", "System"), name=name)
+    elements = ET.SubElement(system, _q("ssd", "Elements"))
+    comps = (
+        ("contact", f"resources/{CONTACT_ID}.fmu", cvars, contact_values,
+         [("Omega", "input"), ("imbalance", "input"), ("friction_torque", "output"), ("n_contact", "output"),
+          ("gap_min", "output")]),
+        ("spool", f"resources/{SPOOL_ID}.fmu", svars, spool_values,
+         [("friction_torque", "input"), ("Omega", "output"), ("drive_torque", "output"),
+          ("windage_torque", "output")]),
+    )
+    for cname, source, vars_, pvalues, conns in comps:
+        comp = ET.SubElement(elements, _q("ssd", "Component"), name=cname, type="application/x-fmu-sharedlibrary",
+                             source=source, implementation="CoSimulation")
+        connectors = ET.SubElement(comp, _q("ssd", "Connectors"))
+        declared = set()
+        for vname, kind in conns:
+            if vname in vars_:
+                _connector(connectors, vars_[vname], kind)
+                declared.add(vname)
+        for vname in pvalues:
+            if vname not in declared:
+                _connector(connectors, vars_[vname], "parameter" if vars_[vname].causality == "parameter" else "input")
+                declared.add(vname)
+        bindings = ET.SubElement(comp, _q("ssd", "ParameterBindings"))
+        ET.SubElement(bindings, _q("ssd", "ParameterBinding"), type="application/x-ssp-parameter-set",
+                      source=f"resources/{cname}.ssv")
+    connections = ET.SubElement(system, _q("ssd", "Connections"))
+    for se, sc, ee, ec in CONNECTIONS:
+        ET.SubElement(connections, _q("ssd", "Connection"), startElement=se, startConnector=sc, endElement=ee,
+                      endConnector=ec)
+    used = []
+    for _c, _s, vars_, pvalues, conns in comps:
+        for vname in [c for c, _k in conns] + list(pvalues):
+            u = vars_[vname].unit if vname in vars_ else None
+            if u and u not in used:
+                used.append(u)
+    enums = {v.declared_type for _c, _s, vars_, pvalues, conns in comps
+             for v in vars_.values() if v.type == "Enumeration" and v.name in pvalues}
+    if enums:
+        en_el = ET.SubElement(root, _q("ssd", "Enumerations"))
+        for name, items in enumerations(croot).items():
+            if name in enums:
+                e = ET.SubElement(en_el, _q("ssc", "Enumeration"), name=name)
+                for item, value in items:
+                    ET.SubElement(e, _q("ssc", "Item"), name=item, value=str(value))
+    _units(ET.SubElement(root, _q("ssd", "Units")), used, all_units)
+    de = ET.SubElement(root, _q("ssd", "DefaultExperiment"), startTime="0.0", stopTime=_fmt(t_end))
+    ann = ET.SubElement(ET.SubElement(de, _q("ssd", "Annotations")), _q("ssc", "Annotation"),
+                        type="org.rotorub.master")
+    ET.SubElement(ann, f"{{{MASTER_NS}}}FixedStepMaster", stepSize=_fmt(h), exchange="Jacobi",
+                  description="fixed communication step; at each communication point both FMUs get the other's "
+                              "outputs at that point, then both step (inputs held over the step)")
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("SystemStructure.ssd", _xml_bytes(root))
+        z.write(contact_fmu, f"resources/{CONTACT_ID}.fmu")
+        z.write(spool_fmu, f"resources/{SPOOL_ID}.fmu")
+        z.writestr("resources/contact.ssv", _parameter_set("contact", contact_values, cvars, all_units))
+        z.writestr("resources/spool.ssv", _parameter_set("spool", spool_values, svars, all_units))
+    return path
+
+
+@cache
+def _schema(name: str):
+    from lxml import etree
+
+    return etree.XMLSchema(etree.parse(str(SCHEMA_DIR / name)))
+
+
+def _schema_problems(xml: bytes, schema_file: str, where: str) -> tuple[list[str], object]:
+    from lxml import etree
+
+    try:
+        doc = etree.fromstring(xml)
+    except etree.XMLSyntaxError as exc:
+        return [f"{where}: not well-formed XML ({exc})"], None
+    schema = _schema(schema_file)
+    if schema.validate(doc):
+        return [], doc
+    return [f"{where}:{e.line}: {e.message}" for e in schema.error_log], doc
+
+
+def validate_ssp(path: str | Path) -> list[str]:
+    """Problems of an SSP package (empty list: valid).
+
+    Checks ``SystemStructure.ssd`` against the SSP 1.0 SystemStructureDescription
+    schema and every ``.ssv`` parameter set it binds against the
+    SystemStructureParameterValues schema (XML Schema 1.0, lxml), then that each
+    component's FMU is in the package, that its connectors exist in the FMU with a
+    compatible causality, that connections join declared connectors from an output
+    to an input, and that every bound parameter names a variable of the FMU.
+    """
+    problems: list[str] = []
+    try:
+        z = zipfile.ZipFile(path)
+    except (OSError, zipfile.BadZipFile) as exc:
+        return [f"{path}: not a readable zip file ({exc})"]
+    with z:
+        names = set(z.namelist())
+        if "SystemStructure.ssd" not in names:
+            return [f"{path}: SystemStructure.ssd missing (the default SSD of an SSP)"]
+        for n in sorted(names):
+            if n.endswith(".ssd") and n != "SystemStructure.ssd":  # variant SSDs
+                p, _ = _schema_problems(z.read(n), "SystemStructureDescription.xsd", n)
+                problems += p
+        p, doc = _schema_problems(z.read("SystemStructure.ssd"), "SystemStructureDescription.xsd",
+                                  "SystemStructure.ssd")
+        problems += p
+        if doc is None:
+            return problems
+        ns = {"ssd": NS["ssd"], "ssc": NS["ssc"], "ssv": NS["ssv"]}
+        connectors: dict[tuple[str, str], str] = {}
+        for sys_el in doc.iter(_q("ssd", "System")):
+            for c in sys_el.findall("ssd:Connectors/ssd:Connector", ns):
+                connectors[("", c.get("name"))] = c.get("kind")
+        for comp in doc.iter(_q("ssd", "Component")):
+            cname, src = comp.get("name"), comp.get("source")
+            if comp.get("type", "application/x-fmu-sharedlibrary") != "application/x-fmu-sharedlibrary":
+                continue
+            if src not in names:
+                problems.append(f"component '{cname}': source '{src}' is not in the package")
+                continue
+            try:
+                fvars, _, _ = read_description(z.read(src))
+            except Exception as exc:  # noqa: BLE001 - reported
+                problems.append(f"component '{cname}': {src} is not a readable FMU ({exc})")
+                continue
+            for c in comp.findall("ssd:Connectors/ssd:Connector", ns):
+                vname, kind = c.get("name"), c.get("kind")
+                connectors[(cname, vname)] = kind
+                var = fvars.get(vname)
+                if var is None:
+                    problems.append(f"component '{cname}': connector '{vname}' is not a variable of {src}")
+                elif kind != var.causality:
+                    problems.append(f"component '{cname}': connector '{vname}' has kind '{kind}' but the FMU's "
+                                    f"variable has causality '{var.causality}'")
+            for b in comp.findall("ssd:ParameterBindings/ssd:ParameterBinding", ns):
+                bsrc = b.get("source")
+                if bsrc is None:
+                    sets = b.findall("ssd:ParameterValues/ssv:ParameterSet", ns)
+                    xmls = [ET.tostring(s) for s in sets]
+                else:
+                    if bsrc not in names:
+                        problems.append(f"component '{cname}': parameter set '{bsrc}' is not in the package")
+                        continue
+                    xmls = [z.read(bsrc)]
+                for xml in xmls:
+                    p, sdoc = _schema_problems(xml, "SystemStructureParameterValues.xsd", bsrc or "inline ssv")
+                    problems += p
+                    if sdoc is None:
+                        continue
+                    for par in sdoc.iter(_q("ssv", "Parameter")):
+                        pname = par.get("name")
+                        var = fvars.get(pname)
+                        if var is None or var.causality not in ("parameter", "input"):
+                            problems.append(f"component '{cname}': {bsrc or 'inline ssv'} sets '{pname}', which is "
+                                            f"not a parameter or input of {src}")
+        for con in doc.iter(_q("ssd", "Connection")):
+            s = (con.get("startElement") or "", con.get("startConnector"))
+            e = (con.get("endElement") or "", con.get("endConnector"))
+            for end, role, ok_kinds in ((s, "start", ("output", "parameter", "calculatedParameter", "inout")),
+                                        (e, "end", ("input", "parameter", "inout"))):
+                kind = connectors.get(end)
+                label = f"{end[0]}.{end[1]}" if end[0] else end[1]
+                if kind is None:
+                    problems.append(f"connection {s[0]}.{s[1]} -> {e[0]}.{e[1]}: {role} connector {label} is not "
+                                    "declared")
+                elif end[0] and kind not in ok_kinds:
+                    problems.append(f"connection {s[0]}.{s[1]} -> {e[0]}.{e[1]}: {role} connector {label} has kind "
+                                    f"'{kind}'")
+    return problems
+
+
+def ssp_contents(path: str | Path) -> dict:
+    """What an SSP names: {"components": {name: source}, "connections": [(se, sc, ee, ec), ...]}."""
+    with zipfile.ZipFile(path) as z:
+        root = ET.fromstring(z.read("SystemStructure.ssd"))
+    comps = {c.get("name"): c.get("source") for c in root.iter(_q("ssd", "Component"))}
+    conns = [(c.get("startElement"), c.get("startConnector"), c.get("endElement"), c.get("endConnector"))
+             for c in root.iter(_q("ssd", "Connection"))]
+    return {"components": comps, "connections": conns}
+
+
