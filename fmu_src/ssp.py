@@ -19,6 +19,8 @@ from functools import cache
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
+import numpy as np
+
 from .system import (
     CONNECTIONS,
     CONTACT_ID,
@@ -125,8 +127,15 @@ def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, 
         if k not in spool_values:
             raise EngineError(f"write_ssp: spool parameter '{k}' unknown; known: {', '.join(spool_values)}")
         spool_values[k] = float(v)
-    contact_values = {"g0": float(g0), "formulation": str(formulation), "mode": str(mode),
-                      "imbalance": float(imbalance)}
+    contact_values = {"g0": float(g0), "imbalance": float(imbalance)}
+    # Enumeration parameters only when they differ from the FMU's defaults: libcosim's SSP parser (0.0.6)
+    # stops at any Enumeration ("Don't know how to handle Enumeration type"), and the defaults need no value
+    items = enumerations(croot)
+    for name, value in (("formulation", formulation), ("mode", mode)):
+        var = cvars[name]
+        default = next((n for n, v in items.get(var.declared_type or "", []) if str(v) == var.start), var.start)
+        if str(value) != default:
+            contact_values[name] = str(value)
     for k, v in (contact_params or {}).items():
         if k not in cvars or cvars[k].causality not in ("parameter", "input"):
             raise EngineError(f"write_ssp: contact parameter '{k}' is not a parameter or input of the contact FMU")
@@ -321,3 +330,46 @@ def ssp_contents(path: str | Path) -> dict:
     return {"components": comps, "connections": conns}
 
 
+
+
+def run_ssp_libcosim(ssp: str | Path, t_end: float, h: float = 1e-3,
+                     record: tuple[tuple[str, str], ...] = (("spool", "Omega"), ("contact", "friction_torque"))
+                     ) -> dict[str, np.ndarray]:
+    """Run an SSP package as written in OSP libcosim (``CosimExecution.from_ssp_file``, fixed step h).
+
+    Returns the time points and the recorded variables ("component.variable") after each step.
+    libcosim 0.0.6 reads Real, Integer, Boolean and String variables and parameter values only:
+    :func:`write_ssp` leaves the contact FMU's Enumeration parameters out when they keep their
+    defaults, so the default engine package runs here.
+    """
+    try:
+        from libcosimpy.CosimExecution import CosimExecution
+        from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+        from libcosimpy.CosimObserver import CosimObserver
+    except ImportError:
+        raise EngineError("run_ssp_libcosim: libcosimpy is not installed (pip install libcosimpy; Linux x86_64, "
+                          "Python >= 3.11)") from None
+    log_output_level(CosimLogLevel.ERROR)
+    steps = int(round(t_end / h))
+    ex = CosimExecution.from_ssp_file(str(ssp), step_size=round(h * 1e9))  # libcosim's time unit: ns
+    observer = CosimObserver.create_last_value()
+    if not ex.add_observer(observer):
+        raise EngineError("run_ssp_libcosim: cannot add an observer")
+    index = {s.name.decode(): s.index for s in ex.slave_infos()}
+    refs = {}
+    for comp, var in record:
+        if comp not in index:
+            raise EngineError(f"run_ssp_libcosim: no component '{comp}' in {ssp}")
+        names = {v.name.decode(): v.reference for v in ex.slave_variables(index[comp])}
+        if var not in names:
+            raise EngineError(f"run_ssp_libcosim: component '{comp}' has no variable '{var}'")
+        refs[f"{comp}.{var}"] = (index[comp], names[var])
+    out = {k: np.empty(steps) for k in refs}
+    for k in range(steps):
+        if not ex.step(1):
+            raise EngineError(f"run_ssp_libcosim: step {k} (t = {k * h:g} s) failed; libcosim state "
+                              f"{ex.status().state}")
+        for key, (i, ref) in refs.items():
+            out[key][k] = observer.last_real_values(i, [ref])[0]
+    del ex, observer
+    return {"t": (np.arange(steps) + 1) * h, **out}

@@ -287,3 +287,26 @@ def test_bad_input_is_reported_through_fmpy_and_a_new_instance_works(fmus):
     # a brand-new coupled run in the same process works
     r = run_coupled(fmus["contact"], fmus["spool"], t_end=0.05, g0=0.05, spool_params=SP)
     assert r.meta["steps_done"] == 50 and np.array_equal(r.omega, schedule(r.t)[0])
+
+
+@pytest.mark.parametrize("flavour", ["pythonfmu", "native"])
+def test_ssp_runs_in_libcosim_and_gives_the_fmpy_master_loops_spool_speed(flavour, fmus, tmp_path, request):
+    """The package as written, loaded by a second co-simulation engine (OSP libcosim, from_ssp_file), with
+    either contact FMU: with rub, its spool speed and friction torque are the fmpy loop's (both masters
+    exchange at the communication points and hold the inputs over the step)."""
+    pytest.importorskip("libcosimpy", reason="libcosimpy: Linux x86_64, Python >= 3.11")
+    from fmu_src.ssp import run_ssp_libcosim
+
+    contact = Path(request.getfixturevalue("contact_fmu" if flavour == "pythonfmu" else "native_fmu"))
+    t_end = 1.2
+    sp = {**SP, "Omega0": 183.0, "Omega1": 190.0, "t_ramp_start": 0.1, "t_ramp": 1.0}  # at the critical: rub
+    ssp = write_ssp(tmp_path / "engine.ssp", contact, fmus["spool"], g0=CFG["g0_rub"], imbalance=CFG["imbalance"],
+                    spool_params=sp, t_end=t_end, h=CFG["h"])
+    assert validate_ssp(ssp) == []
+    lc = run_ssp_libcosim(ssp, t_end, CFG["h"])
+    ref = run_coupled(contact, fmus["spool"], t_end=t_end, h=CFG["h"], g0=CFG["g0_rub"], imbalance=CFG["imbalance"],
+                      spool_params=sp)
+    assert ref.friction_torque.min() < -1.0, "the scenario must rub for the comparison to say something"
+    np.testing.assert_allclose(lc["spool.Omega"], ref.omega[1:], rtol=1e-9)
+    np.testing.assert_allclose(lc["contact.friction_torque"], ref.friction_torque[1:], rtol=1e-9,
+                               atol=1e-9 * np.abs(ref.friction_torque).max())
