@@ -172,14 +172,16 @@ def compile_binary(sources: Path, out: Path, platform: str | None) -> Path:
         compiler, triple = Compiler(tuple(zig), "zig"), ["-target", ZIG_TARGETS[platform]]
     win = platform == "win64"
     out.parent.mkdir(parents=True, exist_ok=True)
-    cmd = [*compiler.command, *triple, *CFLAGS, "-shared", "-DRR_API=", *([] if win else ["-fPIC"]), f"-I{sources}",
-           "-o", str(out), *(str(sources / s) for s in C_SOURCES), *([] if win else ["-lm"])]
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    if r.returncode != 0 or not out.exists():
-        raise CompilerError(f"native FMU for {platform or 'this machine'}: {compiler.name} failed:\n"
-                            f"{r.stderr.strip()[-4000:]}")
-    for extra in (".lib", ".pdb"):
-        out.with_suffix(extra).unlink(missing_ok=True)
+    with tempfile.TemporaryDirectory(prefix="rotorub_cc_") as work:
+        # in a folder of its own: a Windows build also leaves an import library and debug data behind
+        target = Path(work) / out.name
+        cmd = [*compiler.command, *triple, *CFLAGS, "-shared", "-DRR_API=", *([] if win else ["-fPIC"]),
+               f"-I{sources}", "-o", str(target), *(str(sources / s) for s in C_SOURCES), *([] if win else ["-lm"])]
+        r = subprocess.run(cmd, capture_output=True, text=True, cwd=work)
+        if r.returncode != 0 or not target.exists():
+            raise CompilerError(f"native FMU for {platform or 'this machine'}: {compiler.name} failed:\n"
+                                f"{r.stderr.strip()[-4000:]}")
+        shutil.move(str(target), out)
     return out
 
 

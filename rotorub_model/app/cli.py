@@ -197,8 +197,8 @@ def cmd_reproduce(ns: argparse.Namespace) -> dict:
         from ..errors import ParameterError
 
         try:
-            from fmu_src.reproduce_fmu import run_fmu_part
-        except ImportError as exc:
+            run_fmu_part = _entry_point("rotorub.reproduce", "fmu")
+        except (LookupError, ImportError) as exc:
             raise ParameterError(f"reproduce: the FMU part needs the fmu extra ({exc}); "
                                  "pip install -e '.[fmu]', or run with --no-fmu") from None
         s.update(run_fmu_part(model, ns.out, s, quick=ns.quick, fmu_dir=ns.fmu_dir, params_file=ns.params))
@@ -212,23 +212,6 @@ def cmd_reproduce(ns: argparse.Namespace) -> dict:
             "written": str(Path(ns.out) / "summary.json")}
 
 
-@command("build-fmu", "package the contact model as fmus/RotorCasingContact.fmu (FMI 2.0 co-simulation)")
-def cmd_build_fmu(ns: argparse.Namespace) -> dict:
-    """--params FILE becomes the FMU's default parameter file; --out is the folder of the .fmu
-    (default for this command: fmus/). Needs the repository's fmu_src/ and pythonfmu."""
-    from ..errors import ParameterError
-
-    try:
-        from fmu_src import build as mod
-    except ImportError as exc:
-        raise ParameterError(f"build-fmu: {exc}; install the FMU extra: pip install -e '.[fmu]'") from None
-    dest = Path("fmus") if ns.out == "out/build-fmu" else Path(ns.out)
-    try:
-        return mod.build_fmu(dest, ns.params)
-    except mod.BuildError as exc:
-        raise ParameterError(f"build-fmu: {exc}") from None
-
-
 class _OneLineParser(argparse.ArgumentParser):
     """argparse that reports a bad argument on one line (no usage dump)."""
 
@@ -236,9 +219,33 @@ class _OneLineParser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 
+def _entry_point(group: str, name: str):
+    """An object another installed package offers the CLI (the FMU side registers its commands so;
+    the library itself never imports it)."""
+    from importlib.metadata import entry_points
+
+    for ep in entry_points(group=group):
+        if ep.name == name:
+            return ep.load()
+    raise LookupError(f"no '{name}' in the entry points '{group}'")
+
+
+def _plugin_commands() -> None:
+    """Commands registered by installed packages (group rotorub.commands: (name, help, add_args, run))."""
+    from importlib.metadata import entry_points
+
+    for ep in entry_points(group="rotorub.commands"):
+        try:
+            name, help_text, add_args, run = ep.load()
+        except ImportError:  # the extra that provides it is not installed: the command is simply absent
+            continue
+        COMMANDS.setdefault(name, (help_text, add_args, run))
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = _OneLineParser(prog="rotorub", description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="command", required=True)
+    _plugin_commands()
     for name, (help_text, add_args, _) in COMMANDS.items():
         sp = sub.add_parser(name, help=help_text)
         sp.add_argument("--params", default=None, help="parameter file (TOML); default: embedded reference")

@@ -142,18 +142,18 @@ def compile_shared(sources: list[Path], out: Path, compiler: Compiler | None = N
         triple = []
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(f".{out.name}.{os.getpid()}.tmp")
     defs = [f"-D{k}={v}" for k, v in (defines or {}).items()]
     incs = [f"-I{p}" for p in (include or [])]
     win = (target or host_os()).startswith("win")
-    cmd = [*compiler.command, *triple, *CFLAGS, "-shared", *([] if win else ["-fPIC"]), "-DRR_BUILD_SHARED",
-           *defs, *incs, "-o", str(tmp), *map(str, sources), *([] if win else ["-lm"])]
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    if r.returncode != 0 or not tmp.exists():
-        tmp.unlink(missing_ok=True)
-        raise CompilerError(f"compiling {', '.join(p.name for p in sources)} with {compiler.name} failed "
-                            f"(exit {r.returncode}):\n{r.stderr.strip()[-4000:]}")
-    os.replace(tmp, out)
-    for extra in (".lib", ".pdb"):  # zig's import library and debug file of a DLL: not needed
-        tmp.with_suffix(extra).unlink(missing_ok=True)
+    with tempfile.TemporaryDirectory(prefix="rotorub_cc_", dir=out.parent) as work:
+        # in a folder of its own (a Windows build also leaves an import library and debug data behind),
+        # then moved in place atomically: a reader never sees a half-written library
+        tmp = Path(work) / out.name
+        cmd = [*compiler.command, *triple, *CFLAGS, "-shared", *([] if win else ["-fPIC"]), "-DRR_BUILD_SHARED",
+               *defs, *incs, "-o", str(tmp), *map(str, sources), *([] if win else ["-lm"])]
+        r = subprocess.run(cmd, capture_output=True, text=True, cwd=work)
+        if r.returncode != 0 or not tmp.exists():
+            raise CompilerError(f"compiling {', '.join(p.name for p in sources)} with {compiler.name} failed "
+                                f"(exit {r.returncode}):\n{r.stderr.strip()[-4000:]}")
+        os.replace(tmp, out)
     return out

@@ -1,0 +1,58 @@
+"""The FMU side's commands for the ``rotorub`` CLI, found through entry points (the library never imports this
+package): ``build-fmu`` (group ``rotorub.commands``) and the FMU part of ``reproduce`` (group
+``rotorub.reproduce``, fmu_src/reproduce_fmu.py)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+
+def _add_build_args(sp: argparse.ArgumentParser) -> None:
+    sp.add_argument("--native", action="store_true",
+                    help="the native C FMU (no Python on the host) instead of the pythonfmu one")
+    sp.add_argument("--mode", default="transient", choices=["transient", "quasi_static"],
+                    help="default of the mode parameter, and the output dependencies the FMU declares")
+    sp.add_argument("--platforms", nargs="+", default=None,
+                    help="platforms to build (native: linux64 win64 darwin64 aarch64-darwin; pythonfmu kernel: "
+                         "linux64 win64); default: this one plus what ziglang can cross-compile")
+
+
+def build(dest: str | Path, params: str | Path | None = None, native: bool = False, mode: str = "transient",
+          platforms: tuple[str, ...] | None = None) -> dict:
+    """Build one FMU flavour into ``dest`` and write the cross-check kit next to it."""
+    from rotorub_model.structure.params import load_parameters
+
+    from . import crosscheck
+
+    if native:
+        from .build_native import build_native_fmu
+
+        out = build_native_fmu(dest, params, platforms, mode)
+    else:
+        from .build import build_fmu
+
+        out = build_fmu(dest, params, platforms, mode)
+    kit = crosscheck.write_kit(Path(out["fmu"]).parent, load_parameters(params) if params else None)
+    return {**out, "crosscheck_kit": sorted(str(p) for p in kit.values())}
+
+
+def _run_build(ns: argparse.Namespace) -> dict:
+    from rotorub_model.errors import ParameterError
+    from rotorub_model.kernel.compiler import CompilerError
+
+    from .build import BuildError
+    from .build_native import NativeBuildError
+
+    default = Path("fmus") / ("native" if ns.native else "")
+    dest = default if ns.out == "out/build-fmu" else Path(ns.out)
+    try:
+        return build(dest, ns.params, ns.native, ns.mode, tuple(ns.platforms) if ns.platforms else None)
+    except (BuildError, NativeBuildError, CompilerError) as exc:
+        raise ParameterError(f"build-fmu: {exc}") from None
+
+
+# (name, help, add_arguments, run): what rotorub_model.app.cli registers for each entry point
+BUILD_FMU = ("build-fmu", "package the contact model as an FMI 2.0 co-simulation FMU: fmus/RotorCasingContact.fmu "
+             "(pythonfmu) or, with --native, fmus/native/RotorCasingContact.fmu (C, no Python on the host)",
+             _add_build_args, _run_build)
