@@ -230,7 +230,7 @@ def main(argv: list[str] | None = None) -> int:
     n1 = int(round(t_end / 1e-3))
     results = {}
     for path in fmus:
-        name = Path(path).name
+        name = f"{Path(path).parent.name}/{Path(path).name}"
         t1, n_out = lean_time(path, 1e-3)
         t01, _ = lean_time(path, 1e-4)
         sim = best(lambda p=path: simulate_fmu(p, stop_time=t_end, output_interval=1e-3,

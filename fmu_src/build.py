@@ -55,6 +55,48 @@ class BuildError(Exception):
     pass
 
 
+# pythonfmu 0.7.0's linux64 binary (libpythonfmu-export.so) releases its global
+# std::shared_ptr<PyState> twice at process exit: the C++ static destructor of `pyState`
+# (run by exit() through __cxa_atexit) frees the control block, then the ELF destructor
+# onLibraryUnload() -> finalizePythonInterpreter() runs `pyState = nullptr` on the destroyed
+# shared_ptr and decrements the use count inside the freed block (a 4-byte write into freed
+# memory; valgrind: "Invalid read of size 4 ... inside a block of size 128 free'd"). The .so is
+# never really unloaded (its STB_GNU_UNIQUE symbols make it NODELETE, so fmpy's dlclose is a no-op),
+# hence both always run at exit; when the freed chunk sits in a malloc bin the write corrupts its
+# link and glibc aborts later in _dl_fini ("corrupted double-linked list", 1 in 20 to 1 in 8
+# processes). The static destructor alone already releases the PyState (and finalises Python in a
+# native host), so the fix is one byte: onLibraryUnload's `jmp finalizePythonInterpreter` becomes
+# `ret`. benchmarks/bench_exit.py counts the abnormal exits before and after.
+_PYTHONFMU_SO_SHA256 = "4be156a552c16f30eb4395805c59855d8d4086056d0f165442565f6c5fbac0c9"  # 0.7.0 linux64
+_ON_UNLOAD_OFFSET = 0x16F30  # onLibraryUnload: endbr64; jmp finalizePythonInterpreter@plt
+_ON_UNLOAD_BYTES = bytes.fromhex("f30f1efae9")
+
+
+def _patch_exit_double_release(fmu: Path) -> bool:
+    """Rewrite the FMU with its linux64 binary patched (see above); False (and a warning) if the binary
+    is not the known pythonfmu 0.7.0 one."""
+    member = f"binaries/linux64/{MODEL_IDENTIFIER}.so"
+    with zipfile.ZipFile(fmu) as z:
+        infos = z.infolist()
+        data = {i.filename: z.read(i.filename) for i in infos}
+    so = bytearray(data.get(member, b""))
+    if hashlib.sha256(so).hexdigest() != _PYTHONFMU_SO_SHA256:
+        print(f"build-fmu: warning: {member} is not pythonfmu 0.7.0's known binary: its exit-time double release "
+              "is not patched (processes may abort at exit; see fmu_src/build.py)", file=sys.stderr)
+        return False
+    o = _ON_UNLOAD_OFFSET
+    if so[o:o + 5] != _ON_UNLOAD_BYTES:
+        raise BuildError(f"{member}: unexpected code at onLibraryUnload; not patched")
+    so[o + 4] = 0xC3  # ret
+    data[member] = bytes(so)
+    tmp = fmu.with_suffix(".fmu.tmp")
+    with zipfile.ZipFile(tmp, "w") as z:
+        for i in infos:
+            z.writestr(i, data[i.filename], compress_type=i.compress_type)
+    tmp.replace(fmu)
+    return True
+
+
 def _library_files() -> list[Path]:
     files = [p for p in sorted(LIB.rglob("*")) if p.is_file() and "__pycache__" not in p.parts
              and "bin" not in p.relative_to(LIB).parts and p.suffix in (".py", ".toml", ".c", ".h")]
@@ -217,13 +259,14 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
                 if m.split(".")[0] in (module_name, lib_name, interface_name, f"_doc_{module_name}"):
                     sys.modules.pop(m, None)
             sys.path[:] = path_before
+    exit_patch = _patch_exit_double_release(out_file)
     with zipfile.ZipFile(out_file) as z:
         names = z.namelist()
         md = z.read("modelDescription.xml").decode()
     return {"fmu": str(out_file), "size_bytes": out_file.stat().st_size, "files": len(names),
             "variables": md.count("<ScalarVariable"), "blades": params.blades.count, "build": tag,
             "parameters": str(params_path), "host_requirements": HOST_REQUIREMENTS,
-            "kernel_platforms": manifest["kernel_platforms"]}
+            "kernel_platforms": manifest["kernel_platforms"], "exit_double_release_patched": exit_patch}
 
 
 def main(argv: list[str] | None = None) -> int:

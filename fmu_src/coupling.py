@@ -440,6 +440,16 @@ def run_coupled_scenario(out_dir: str | Path, quick: bool = True, contact_fmu: s
                     "no_rub_wall_time_s": ref.meta["wall_time_s"], "build_time_s": build_s, "ssp": str(ssp),
                     "ssp_valid": True, "contact_fmu": str(contact_fmu), "spool_fmu": str(spool_fmu),
                     "quick": quick})
+    try:  # the same package in a second co-simulation engine, when it is installed
+        from .ssp import run_ssp_libcosim
+
+        lc = run_ssp_libcosim(ssp, cfg["t_end"], cfg["h"])
+        scale = float(np.abs(rub.omega).max())
+        summary["libcosim_ssp_spool_speed_max_rel_diff"] = float(np.abs(lc["spool.Omega"] - rub.omega[1:]).max()
+                                                                 / scale)
+    except EngineError as exc:
+        summary["libcosim_ssp_spool_speed_max_rel_diff"] = None
+        summary["libcosim_note"] = str(exc)
     write_json(out / "summary.json", summary)
     summary["figures"] = [("Coupled run-up: spool speed with and without rub, friction torque, contact forces",
                            "coupled_runup.png")]

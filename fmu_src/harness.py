@@ -37,9 +37,28 @@ def _names(n_blades: int, what: str) -> list[str]:
 
 
 def _extract(fmu: str | Path, where: str | Path) -> str:
+    """The FMU unzipped into ``where``, or the extraction already there if it is of the same file: never
+    over an extraction whose binary may be loaded in this process (rewriting a mapped shared library
+    crashes it)."""
+    import hashlib
+    import zipfile
+
     from fmpy import extract
 
-    return extract(str(fmu), str(Path(where).resolve()))
+    where = Path(where).resolve()
+    stamp = where / ".rotorub_extracted_from"
+    digest = hashlib.sha256(Path(fmu).read_bytes()).hexdigest()
+    if stamp.exists() and stamp.read_text() == digest:
+        return str(where)
+    if where.exists() and any(where.iterdir()):
+        where = where.with_name(f"{where.name}_{digest[:8]}")
+        if (where / ".rotorub_extracted_from").exists():
+            return str(where)
+    with zipfile.ZipFile(fmu):
+        pass  # a clear error for a file that is not an FMU
+    out = extract(str(fmu), str(where))
+    (Path(out) / ".rotorub_extracted_from").write_text(digest)
+    return out
 
 
 def _progress(total: int, desc: str, show: bool):
@@ -104,7 +123,7 @@ def quasi_static_maps(fmu: str | Path, model, speeds: np.ndarray, g0s: np.ndarra
                 for i, sp in enumerate(speeds):
                     s.set(Omega=float(sp * w_ref))
                     try:
-                        s.step(float(i), 1.0)
+                        s.step(None, 1.0)  # from the FMU's time: a refused step does not advance it
                     except Exception:  # noqa: BLE001 - no balanced solution here: the cell stays -1
                         if s.get("status") != 1:
                             raise

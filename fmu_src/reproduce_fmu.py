@@ -21,14 +21,17 @@ def _step(msg: str) -> None:
 def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: str | Path = "fmus",
                  params_file: str | Path | None = None, progress: bool = True) -> dict:
     """Returns the additions to the summary: harness results, fmu_vs_library_max_rel_diff, coupled_run."""
-    from .build import build_fmu
+    from .commands import build
     from .harness import quasi_static_maps, run_up, transient_pair
 
     out = Path(out)
-    _step(f"building the FMU into {fmu_dir}/")
-    info = build_fmu(fmu_dir, params_file)
-    fmu = info["fmu"]
-    res: dict = {"fmu": {"file": fmu, "build": info["build"], "variables": info["variables"]}}
+    _step(f"building both FMU flavours (pythonfmu into {fmu_dir}/, native C into {fmu_dir}/native/), with their "
+          "cross-check kits")
+    info_py = build(fmu_dir, params_file)
+    info = build(Path(fmu_dir) / "native", params_file, native=True)
+    fmu = info["fmu"]  # the product: the harnesses run it; the pythonfmu one is compared with it below
+    res: dict = {"fmu": {"file": fmu, "guid": info["guid"], "platforms": info["platforms"],
+                         "variables": info["variables"], "pythonfmu_file": info_py["fmu"]}}
 
     # sections 4-5 through the FMU: a coarser grid than the library's own maps in --quick
     w = summary["response"]["critical_speeds"][0]
@@ -55,6 +58,9 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
     ru = run_up(fmu, model, out / "fmu_run_up", speed_from=max(w - 0.9, 0.1), speed_to=w + 0.9,
                 duration=4.0 if quick else 8.0, progress=progress)
 
+    _step("the two flavours on the same section-6 scenario (3 s): native vs pythonfmu vs library")
+    res["fmu_flavours"] = compare_flavours(fmu, info_py["fmu"], model, speed, g0, out / "fmu_flavours")
+
     diffs = [pair["2D"]["max_rel_diff_F_N_vs_library"], pair["3D"]["max_rel_diff_F_N_vs_library"],
              ru["max_rel_diff_F_N_vs_library"], ru["max_rel_diff_disk_vs_library"]]
     diffs += [v["max_real_max_rel_diff"] for v in qsum["vs_library"].values()]
@@ -80,3 +86,39 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
         *[(t, str(Path("coupled") / p)) for t, p in coupled.get("figures", [])],
     ]
     return res
+
+
+def compare_flavours(native: str | Path, pythonfmu: str | Path, model, speed: float, g0: float, out: str | Path,
+                     t_end: float = 3.0, h: float = 1e-3) -> dict:
+    """2D and 3D transients at (speed, g0) through both flavours and in the library (same held inputs):
+    max |F_N difference| / max |F_N| of each pair, and whether the two FMUs agree bit for bit."""
+    from rotorub_model.analyses.transient import run_transient
+    from rotorub_model.contact import make_contact
+
+    from .harness import _extract, _rel_diff, run_fmu_transient
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    p = model.params
+    omega, me = speed * p.normalisation.omega_ref, p.imbalance.me
+
+    def me_of_t(t):
+        return me * min(t / 1.0, 1.0)
+
+    s = {"t_end_s": t_end, "h_s": h, "speed": speed, "g0_mm": g0 * 1e3}
+    unzipped = {name: (path, _extract(path, out / f"unzipped_{name}"))
+                for name, path in (("native", native), ("pythonfmu", pythonfmu))}
+    for f in ("2D", "3D"):
+        runs = {name: run_fmu_transient(path, unz, f, g0, lambda _t: omega, me_of_t, t_end, h, p.blades.count,
+                                        name=f"{name}_{f}")
+                for name, (path, unz) in unzipped.items()}
+        lib = run_transient(model, make_contact(model, f, g0=g0), omega, t_end=t_end, t_ramp=1.0, me=me,
+                            record_dt=h, hold=h)
+        a, b = runs["native"].F_N, runs["pythonfmu"].F_N
+        s[f] = {"native_vs_pythonfmu": _rel_diff(a, b), "bit_identical": bool(a.shape == b.shape and
+                                                                            np.array_equal(a, b)),
+                "native_vs_library": _rel_diff(a, lib.outputs["F_N"]),
+                "pythonfmu_vs_library": _rel_diff(b, lib.outputs["F_N"]),
+                "seconds": {k: r.seconds for k, r in runs.items()}}
+    write_json(out / "summary.json", s)
+    return s

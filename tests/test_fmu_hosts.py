@@ -393,3 +393,28 @@ def test_libcosim_bad_input(fmu, md, flavour, when):
     assert proc.returncode == 0, _explain(proc)
     assert "step ok: False" in proc.stdout, _explain(proc)
     assert f"state: {CosimExecutionState.ERROR.value}" in proc.stdout, _explain(proc)
+
+
+# ---------------------------------------------------------------------------------------------- ecospy (Vico ecos)
+def test_ecospy_matches_fmpy(fmu, reference):
+    """A third master, ecos (ecospy), when it can be loaded: it needs the system library libtbb12
+    (Debian/Ubuntu: apt install libtbb12) and `pip install ecospy`, which the test extra does not force on
+    every machine. Both flavours give fmpy's F_N to 1e-12."""
+    pytest.importorskip("ecospy", reason="ecospy is not installed or cannot load libtbb.so.12 "
+                                         "(apt install libtbb12; pip install ecospy)")
+    from ecospy import EcosSimulation, EcosSimulationStructure
+
+    sc = SCENARIO
+    ss = EcosSimulationStructure()
+    ss.add_model("rotor", str(fmu))
+    sim = EcosSimulation(structure=ss, step_size=sc["h"])
+    for k in ("g0", "Omega", "imbalance"):
+        sim.set_real(f"rotor::{k}", sc[k])
+    sim.init()
+    rows = []
+    for _ in range(sc["steps"]):
+        sim.step()
+        rows.append([sim.get_real(f"rotor::{n}") for n in _fn_names()])
+    sim.terminate()
+    sim.free()
+    _compare(np.array(rows), reference["F_N"][1:])

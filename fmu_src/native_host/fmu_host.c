@@ -26,6 +26,8 @@
  *                 V0 + (V1 - V0) * k / (STEPS - 1) at step k = 0..STEPS-1 (V0 if V1 omitted)
  *   -e K:VR=REAL  from step K on, the input (or tunable parameter) VR is REAL (overrides -u)
  *   -o VR / -i VR Real / Integer variable printed as a CSV column (in the order given)
+ *   -b            benchmark: print no rows; time the stepping loop (set the inputs, fmi2DoStep, read the
+ *                 outputs) and instantiate .. end of the first step, on stderr
  *   -q            loggingOn = fmi2False (default: fmi2True; pythonfmu forwards the slave's
  *                 log messages only when logging is on)
  *
@@ -52,6 +54,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 /* ---------------------------------------------------------------- FMI 2.0 declarations
  * The subset of fmi2TypesPlatform.h / fmi2FunctionTypes.h this host uses (FMI 2.0 standard,
@@ -147,7 +150,7 @@ typedef struct { fmi2ValueReference vr; const char *value; } StrParam;
 static void usage(const char *msg)
 {
     fprintf(stderr, "fmu_host: %s\nusage: fmu_host -d DIR [-m MODEL] [-L LIBPYTHON] [-n STEPS] [-s STEP] [-t START] "
-                    "[-q] [-p VR=REAL]... [-I VR=INT]... [-S VR=STRING]... [-u VR=V0[:V1]]... [-e K:VR=REAL]... [-o VR]... "
+                    "[-q] [-b] [-p VR=REAL]... [-I VR=INT]... [-S VR=STRING]... [-u VR=V0[:V1]]... [-e K:VR=REAL]... [-o VR]... "
                     "[-i VR]...\n",
             msg);
     exit(2);
@@ -256,7 +259,8 @@ int main(int argc, char **argv)
     const char *dir = NULL, *model = "RotorCasingContact", *libpython = NULL;
     long steps = 10;
     double h = 1e-3, t0 = 0.0;
-    int logging_on = fmi2True;
+    int logging_on = fmi2True, bench = 0;
+    struct timespec ts0, ts1, ts2;
     static fmi2ValueReference pr_vr[MAX_VARS], pi_vr[MAX_VARS], out_r[MAX_VARS], out_i[MAX_VARS];
     static double pr_val[MAX_VARS];
     static fmi2Integer pi_val[MAX_VARS];
@@ -270,6 +274,10 @@ int main(int argc, char **argv)
         if (opt[0] != '-' || opt[1] == '\0' || opt[2] != '\0') usage("unknown argument");
         if (opt[1] == 'q') {
             logging_on = fmi2False;
+            continue;
+        }
+        if (opt[1] == 'b') {
+            bench = 1;
             continue;
         }
         if (a + 1 >= argc) usage("missing option value");
@@ -366,6 +374,7 @@ int main(int argc, char **argv)
         k += (size_t)(*c == ' ' ? snprintf(resources + k, 4, "%%20") : snprintf(resources + k, 2, "%c", *c));
     snprintf(resources + k, sizeof resources - k, "/resources");
 
+    clock_gettime(CLOCK_MONOTONIC, &ts0);
     fmi2Component c = fmi.Instantiate("host", fmi2CoSimulation, guid, resources, &callbacks, fmi2False, logging_on);
     if (!c) {
         fprintf(stderr, "fmu_host: fmi2Instantiate failed (see the log above)\n");
@@ -395,11 +404,13 @@ int main(int argc, char **argv)
     /* 4. the stepping loop */
     double *r = calloc(nor + 1, sizeof *r);
     fmi2Integer *iv = calloc(noi + 1, sizeof *iv);
-    printf("time,fmi2status");
-    for (size_t i = 0; i < nin; i++) printf(",u%u", in[i].vr);
-    for (size_t i = 0; i < nor; i++) printf(",r%u", out_r[i]);
-    for (size_t i = 0; i < noi; i++) printf(",i%u", out_i[i]);
-    printf("\n");
+    if (!bench) {
+        printf("time,fmi2status");
+        for (size_t i = 0; i < nin; i++) printf(",u%u", in[i].vr);
+        for (size_t i = 0; i < nor; i++) printf(",r%u", out_r[i]);
+        for (size_t i = 0; i < noi; i++) printf(",i%u", out_i[i]);
+        printf("\n");
+    }
 
     int exit_code = 0;
     fmi2Status set_st = fmi2OK;
@@ -409,17 +420,20 @@ int main(int argc, char **argv)
             t_start = t;
             st = fmi.DoStep(c, t, h, fmi2True);
             t = t0 + (double)step * h;
+            if (step == 1) clock_gettime(CLOCK_MONOTONIC, &ts1);
         }
         int readable = st <= fmi2Discard; /* outputs may be inspected after fmi2Discard */
         fmi2Status get_st = fmi2OK;
         if (readable && nor) get_st = fmi.GetReal(c, out_r, nor, r);
         if (readable && noi && get_st <= fmi2Warning) get_st = worst(get_st, fmi.GetInteger(c, out_i, noi, iv));
         readable = readable && get_st <= fmi2Warning;
-        printf("%.17g,%d", t, (int)st);
-        for (size_t i = 0; i < nin; i++) printf(",%.17g", u[i]);
-        for (size_t i = 0; i < nor; i++) printf(readable ? ",%.17g" : ",nan", r[i]);
-        for (size_t i = 0; i < noi; i++) readable ? printf(",%d", iv[i]) : printf(",");
-        printf("\n");
+        if (!bench) {
+            printf("%.17g,%d", t, (int)st);
+            for (size_t i = 0; i < nin; i++) printf(",%.17g", u[i]);
+            for (size_t i = 0; i < nor; i++) printf(readable ? ",%.17g" : ",nan", r[i]);
+            for (size_t i = 0; i < noi; i++) readable ? printf(",%d", iv[i]) : printf(",");
+            printf("\n");
+        }
         if (st > fmi2Warning) {
             fprintf(stderr, "fmu_host: fmi2DoStep(%.17g, %.17g) returned %s; stopping\n", t_start, h,
                     status_name(st));
@@ -457,6 +471,11 @@ int main(int argc, char **argv)
         fflush(stdout);
     }
     fflush(stdout);
+    clock_gettime(CLOCK_MONOTONIC, &ts2);
+    if (bench && steps > 1)
+        fprintf(stderr, "fmu_host: bench: instantiate to end of first step %.6f s; steps 2..%ld: %.9f s per step\n",
+                (double)(ts1.tv_sec - ts0.tv_sec) + 1e-9 * (double)(ts1.tv_nsec - ts0.tv_nsec), steps,
+                ((double)(ts2.tv_sec - ts1.tv_sec) + 1e-9 * (double)(ts2.tv_nsec - ts1.tv_nsec)) / (double)(steps - 1));
 
     /* 5. shut down: fmi2Terminate is not allowed after fmi2Error/fmi2Fatal; fmi2FreeInstance is, after Error */
     if (st <= fmi2Discard) {

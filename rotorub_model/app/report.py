@@ -48,6 +48,18 @@ def _fmu_section(summary: dict) -> list[str]:
              f"({summary.get('fmu_vs_library_note', '')}).", "",
              "| harness (through the FMU, fmpy) | max rel. diff vs library | notes |", "|---|---|---|"]
     lines += [f"| {a} | {b:.2e} | {c} |" for a, b, c in rows]
+    fl = summary.get("fmu_flavours")
+    if fl:
+        lines += ["", "## The two FMU flavours on the same scenario", "",
+                  f"Section-6 point, {fl['t_end_s']:g} s, h = {fl['h_s'] * 1e3:g} ms, inputs held over each step "
+                  "(native C FMU, pythonfmu FMU, library `run_transient(hold=h)`).", "",
+                  "| formulation | native vs pythonfmu | bit for bit | native vs library | wall time native / "
+                  "pythonfmu [s] |", "|---|---|---|---|---|"]
+        for f in ("2D", "3D"):
+            v = fl[f]
+            lines.append(f"| {f} | {v['native_vs_pythonfmu']:.1e} | {v['bit_identical']} | "
+                         f"{v['native_vs_library']:.1e} | {v['seconds']['native']:.3f} / "
+                         f"{v['seconds']['pythonfmu']:.3f} |")
     c = summary.get("coupled_run")
     if c:
         lines += ["", "## Coupled engine scenario (LP spool FMU + contact FMU)", "",
