@@ -189,7 +189,7 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
         raise BuildError("pythonfmu is not installed: pip install 'rotorub[fmu]'") from None
     from rotorub_model import __version__ as lib_version
     from rotorub_model.structure.model import build_model, save_model
-    from rotorub_model.structure.params import load_parameters
+    from rotorub_model.structure.params import load_parameters, to_dict
 
     params_path = Path(params_file) if params_file else LIB / "data" / "reference.toml"
     params = load_parameters(params_path)  # validated now, not in the master
@@ -234,6 +234,7 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
         model = build_model(params)
         save_model(model, stage / "model.npz")
         manifest["n_dofs"] = model.n_dofs
+        manifest["parameter_values"] = to_dict(params)  # read without a TOML parser (Python 3.10 has none)
         shutil.copy2(INTERFACE, stage / f"{interface_name}.py")
         manifest["kernel_platforms"] = _kernel_binaries(pkg, platforms)
         (stage / "rotorub_fmu.json").write_text(json.dumps(manifest, indent=1))

@@ -72,7 +72,7 @@ class RotorCasingContact(Fmi2Slave):
         itf = self._if
         self.version = self._manifest.get("library_version", "0")
         self.copyright = "rotorub developers"
-        self._ref = self._lib.params.load_parameters(self._resources / self._manifest["parameters"])
+        self._ref = self._lib.params.from_dict(self._manifest["parameter_values"])
         self._feedthrough = bool(self._manifest.get("feedthrough", False))
         self._vars = itf.variables(itf.Defaults.from_parameters(self._ref), self._manifest.get("mode", "transient"))
         n = len(self._vars)
