@@ -52,3 +52,38 @@ def test_inverse(ref_model):
     assert np.abs(Ai @ A - np.eye(ref_model.n_dofs)).max() < 1e-10
     with pytest.raises(np.linalg.LinAlgError, match="singular"):
         kernel.inverse(np.zeros((3, 3)))
+
+
+def test_no_compiler_at_all_is_one_clear_error(monkeypatch, tmp_path):
+    """No system compiler, no ziglang, no $CC: one message naming what to install."""
+    from rotorub_model.kernel import compiler
+
+    monkeypatch.setenv("PATH", str(tmp_path))  # an empty folder: no cc, gcc, clang
+    monkeypatch.delenv("CC", raising=False)
+    monkeypatch.delenv("ROTORUB_CC", raising=False)
+    monkeypatch.setattr(compiler, "zig_command", lambda: None)
+    with pytest.raises(compiler.CompilerError) as err:
+        compiler.find_compiler()
+    msg = str(err.value)
+    assert "no C compiler found" in msg and "pip install ziglang" in msg and "apt install gcc" in msg
+
+
+def test_ziglang_alone_builds_a_kernel_that_gives_the_same_numbers(monkeypatch, tmp_path):
+    """The machine-with-only-Python route: the kernel built by ziglang equals the system compiler's."""
+    from rotorub_model.kernel import compiler
+
+    if compiler.zig_command() is None:
+        pytest.skip("ziglang is not installed")
+    monkeypatch.setenv("PATH", str(tmp_path))
+    monkeypatch.delenv("CC", raising=False)
+    monkeypatch.delenv("ROTORUB_CC", raising=False)
+    found = compiler.find_compiler()
+    assert found.kind == "zig"
+    out = kernel.build(tmp_path / "zig_kernel.so")
+    import ctypes
+
+    lib = ctypes.CDLL(str(out))
+    args = [ctypes.c_double(v) for v in (-1e-3, 2e-4, 1.5e6, 0.2)]
+    res = (ctypes.c_double * 7)()
+    lib.rr_blade_law(2, *args, res)
+    assert tuple(res) == kernel.chord_law(-1e-3, 2e-4, 1.5e6, 0.2)
