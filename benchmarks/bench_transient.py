@@ -49,7 +49,7 @@ def bare_library(tmp: Path) -> ctypes.CDLL:
     lib = ctypes.CDLL(str(out))
     dp = ctypes.c_void_p
     lib.bare_cd.argtypes = [ctypes.POINTER(kernel.RRContact), ctypes.POINTER(kernel.RRMatrices), dp, dp,
-                            ctypes.c_int, ctypes.c_double]
+                            ctypes.c_double, ctypes.c_double, ctypes.c_int, ctypes.c_double]
     lib.bare_cd.restype = None
     return lib
 
@@ -82,7 +82,7 @@ def main(argv: list[str] | None = None) -> int:
         def bare_run():
             q[:] = 0.0
             qp[:] = 0.0
-            bare.bare_cd(c.kernel, mats, kernel.ptr(q), kernel.ptr(qp), n_steps, me)
+            bare.bare_cd(c.kernel, mats, kernel.ptr(q), kernel.ptr(qp), r.dt, omega, n_steps, me)
 
         bare_run()
         t_lib = best_of(library, ns.repeat)

@@ -83,7 +83,7 @@ def model_data_source(model, variables: list[interface.Var], guid: str, feedthro
 
     names = [v.name for v in variables]
     fixed = ["Omega", "imbalance", "formulation", "mode", "param_file", "g0", "k_r", "mu", "theta", "chord", "dt_max",
-             "max_penetration"]
+             "max_penetration", "slip_velocity"]
     if names[:len(fixed)] != fixed:
         raise NativeBuildError(f"interface order changed: model.h expects {fixed} first, got {names[:len(fixed)]}")
     vr = {n: i for i, n in enumerate(names)}

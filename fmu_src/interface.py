@@ -39,6 +39,7 @@ UNITS: dict[str, tuple[dict[str, int], dict[str, float]]] = {
     "rad/s": ({"rad": 1, "s": -1}, {"rpm": 60.0 / (2.0 * math.pi)}),
     "kg.m": ({"kg": 1, "m": 1}, {"kg.mm": 1e3}),
     "m": ({"m": 1}, {"mm": 1e3}),
+    "m/s": ({"m": 1, "s": -1}, {}),
     "N/m": ({"kg": 1, "s": -2}, {}),
     "rad": ({"rad": 1}, {"deg": 180.0 / math.pi}),
     "s": ({"s": 1}, {"ms": 1e3}),
@@ -90,6 +91,7 @@ class Defaults:
     theta: float  # [rad]
     chord: float  # [m]
     max_penetration: float  # [m]
+    slip_velocity: float  # [m/s]
 
     @classmethod
     def from_parameters(cls, p) -> Defaults:
@@ -98,7 +100,7 @@ class Defaults:
                    omega_max=p.normalisation.speed_max * p.normalisation.omega_ref, me=p.imbalance.me,
                    me_max=b.mass * (b.hub_radius + 0.5 * b.length), g0=p.contact.g0, k_r=p.contact.k_r,
                    mu=p.contact.mu, theta=math.radians(p.contact.theta_deg), chord=p.contact.chord,
-                   max_penetration=p.contact.max_penetration)
+                   max_penetration=p.contact.max_penetration, slip_velocity=p.contact.slip_velocity)
 
 
 # ranges that are modelling judgements (the descriptions say why)
@@ -109,6 +111,7 @@ THETA_RANGE = (0.0, math.radians(60.0))
 CHORD_RANGE = (1e-3, 0.5)
 DT_MAX_RANGE = (1e-8, 1.0)
 PENETRATION_RANGE = (1e-5, 0.05)
+SLIP_RANGE = (1e-4, 10.0)
 
 
 def variables(d: Defaults, mode: str = "transient") -> list[Var]:
@@ -158,11 +161,18 @@ def variables(d: Defaults, mode: str = "transient") -> list[Var]:
             "deeper than this (the depth of an abradable liner: deeper, the blade cuts the case structure and the "
             "penalty law means nothing)", unit="m", display_unit="mm", start=d.max_penetration,
             min=PENETRATION_RANGE[0], max=PENETRATION_RANGE[1], nominal=3e-3))
+    add(Var("slip_velocity", "Real", "parameter", "fixed",
+            "Velocity scale of the friction law mu tanh(v / slip_velocity), v the sliding speed of a blade point "
+            "over the casing (spin plus vibration): exact Coulomb friction at tip speeds, turning smoothly with "
+            "the sliding near v = 0 (start from rest, run-down, windmilling). Range 0.1 mm/s to 10 m/s (far below "
+            "the tip speeds; the smaller, the smaller the internal step the friction's damping allows)",
+            unit="m/s", start=d.slip_velocity, min=SLIP_RANGE[0], max=SLIP_RANGE[1], nominal=0.1))
     for j in range(1, d.n_blades + 1):
         b = f"blade[{j}]"
         add(Var(f"{b}.F_N", "Real", "output", "continuous", f"Normal contact force on blade {j}", unit="N"))
         add(Var(f"{b}.F_T", "Real", "output", "continuous",
-                f"Tangential (friction) force on blade {j}, mu*F_N, opposing the spin", unit="N"))
+                f"Tangential (friction) force on blade {j}: mu*F_N against its sliding over the casing (positive: "
+                "against the spin)", unit="N"))
         add(Var(f"{b}.gap_LE", "Real", "output", "continuous",
                 f"Gap at the leading edge of blade {j} (2D: the tip gap); negative = penetration", unit="m",
                 display_unit="mm"))

@@ -268,7 +268,8 @@ class RotorCasingContact(Fmi2Slave):
         return {"formulation": enum["Formulation"][self._i("formulation") - 1][0],
                 "mode": enum["Mode"][self._i("mode") - 1][0],
                 "param_file": self._sv[self._slot["param_file"]],
-                **{k: self._r(k) for k in ("k_r", "mu", "theta", "chord", "dt_max", "max_penetration")}}
+                **{k: self._r(k) for k in ("k_r", "mu", "theta", "chord", "dt_max", "max_penetration",
+                                                     "slip_velocity")}}
 
     def _build(self, config: dict | None = None) -> None:
         """Build model, contact and solver from the parameters (raises with a message naming the cause)."""
@@ -287,7 +288,8 @@ class RotorCasingContact(Fmi2Slave):
         g0 = self._r("g0")
         params = params.replace(contact={"g0": g0, "k_r": cfg["k_r"], "mu": cfg["mu"],
                                          "theta_deg": math.degrees(cfg["theta"]), "chord": cfg["chord"],
-                                         "max_penetration": cfg["max_penetration"]})
+                                         "max_penetration": cfg["max_penetration"],
+                                         "slip_velocity": cfg["slip_velocity"]})
         if path:
             try:  # assembling a model needs scipy (the shaft's component modes)
                 model = lib.model.build_model(params)
@@ -310,7 +312,7 @@ class RotorCasingContact(Fmi2Slave):
             q = np.zeros(model.n_dofs)
         self._sim = sim
         self._iv[self._i_status] = self._if.STATUS_OK
-        self._write_outputs(q, 0.0, max_real=0.0)
+        self._write_outputs(q, self._r("Omega"), 0.0, max_real=0.0)
         self._stale = False
         if not sim["transient"]:
             ok, msg = self._quasi_static(self._r("Omega"), self._r("imbalance"), 0.0)
@@ -415,14 +417,14 @@ class RotorCasingContact(Fmi2Slave):
                            f"g0 = {sim['g0']:g} m (relative residual {st.residual:.2e}); the outputs hold the last "
                            "solution")
         # the kernel's eigenvalues: the native FMU computes the same indicator with the same solver
-        A = lib.linear.first_order(sim["model"], omega, sim["contact"].jacobian(st.q))
+        A = lib.linear.first_order(sim["model"], omega, *sim["contact"].jacobians(st.q, omega))
         max_real = float(lib.kernel.eigenvalues(A).real.max())
         sim["q_static"] = st.q
         phi = sim["phi"] + omega * h
         sim["phi"] = phi
         self._rv[self._i_dt] = 0.0
         self._iv[self._i_nsub] = 0
-        self._write_outputs(st.q, phi, max_real=max_real)
+        self._write_outputs(st.q, omega, phi, max_real=max_real)
         self._iv[self._i_status] = self._if.STATUS_UNSTABLE if max_real > RE_TOL else self._if.STATUS_OK
         return True, ""
 
@@ -440,9 +442,10 @@ class RotorCasingContact(Fmi2Slave):
         if not ok:
             self._report(self._if.STATUS_DIVERGED, msg)
 
-    def _write_outputs(self, q: np.ndarray, phi: float, max_real: float) -> None:
-        """The outputs of state q (the kernel's, as in every library analysis), fixed frame at angle phi."""
-        self._sim["contact"].write_outputs(q, phi, self._out_index, self._rv)
+    def _write_outputs(self, q: np.ndarray, omega: float, phi: float, max_real: float) -> None:
+        """The outputs of state q at rest in the rotating frame (the kernel's, as in every library
+        analysis) at spin omega, fixed frame at angle phi."""
+        self._sim["contact"].write_outputs(q, None, omega, phi, self._out_index, self._rv)
         self._iv[self._i_nc] = int(self._rv[self._i_nc])
         self._rv[self._i_maxre] = max_real
 

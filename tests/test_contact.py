@@ -14,6 +14,9 @@ from rotorub_model.structure.model import build_model
 from rotorub_model.structure.params import reference_parameters
 
 K_R = 1.0e7
+# a spin speed whose tip speed (~R_tip x 150 m/s) is far above contact.slip_velocity: friction is exact
+# Coulomb against the spin (tanh = 1 to the last bit); the low-speed law is tested in test_friction.py
+SPIN = 150.0
 L_C = 0.2
 
 
@@ -142,7 +145,7 @@ def test_full_chord_through_contact_model(model, crit):
     c = c.with_clearance(g0)
     g = c.gaps(q)
     assert np.all(g < 0) and np.ptp(g) > 1e-3  # penetrating, with a real spread over blades and chord
-    bf = c.blade_forces(q)
+    bf = c.blade_forces(q, SPIN)
     eta = g.mean(axis=1)
     zeta = (g[:, 1] - g[:, 0]) / c.geometry.chord
     np.testing.assert_allclose(bf["F_N"], -c.k_r * eta, rtol=1e-13)
@@ -152,7 +155,7 @@ def test_full_chord_through_contact_model(model, crit):
     c2 = make_contact(model, "2D", g0=g0)
     g2 = c2.gaps(q)[:, 0]
     assert np.all(g2 < 0)
-    np.testing.assert_allclose(c2.blade_forces(q)["F_N"], -c2.k_r * g2, rtol=1e-14)
+    np.testing.assert_allclose(c2.blade_forces(q, SPIN)["F_N"], -c2.k_r * g2, rtol=1e-14)
 
 
 def partial_le(gle, gte, k=K_R, l=L_C):
@@ -288,7 +291,7 @@ def fd_jacobian(c: ContactModel, q: np.ndarray) -> np.ndarray:
         h = min(1e-8 / gi.max(), 0.01 * np.min(np.abs(g) / np.maximum(gi, 1e-300)))
         e = np.zeros(q.size)
         e[i] = h
-        J[:, i] = (c.forces(q + e) - c.forces(q - e)) / (2 * h)
+        J[:, i] = (c.forces(q + e, SPIN) - c.forces(q - e, SPIN)) / (2 * h)
     return J
 
 
@@ -318,7 +321,7 @@ def test_jacobian_matches_finite_differences(model, crit, form, variant):
     for c, q, got, dist in states:
         covered |= got
         assert dist > 0
-        J = c.jacobian(q)
+        J = c.jacobian(q, SPIN)
         Jfd = fd_jacobian(c, q)
         norms = np.linalg.norm(J, axis=0)
         active = norms > 1e-12 * norms.max()
@@ -340,7 +343,7 @@ def contact_state(model, crit, form, variant="full", g0=None):
         h = np.sort(-(c.G @ q))
         g0 = float(np.median(h))  # about half of the points in contact
     c = c.with_clearance(g0)
-    assert np.any(c.blade_forces(q)["F_N"] > 0) and np.any(c.blade_forces(q)["F_N"] == 0)
+    assert np.any(c.blade_forces(q, SPIN)["F_N"] > 0) and np.any(c.blade_forces(q, SPIN)["F_N"] == 0)
     return c, q
 
 
@@ -350,24 +353,24 @@ def test_virtual_work(model, crit, form):
     their opposites on the casing (at J_c dq)."""
     rng = np.random.default_rng(5)
     c, q = contact_state(model, crit, form)
-    f = c.point_forces(q)
+    f = c.point_forces(q, SPIN)
     geo = c.geometry
     for _ in range(10):
         dq = rng.standard_normal(model.n_dofs)
         ub = np.einsum("jpin,n->jpi", geo.Jb, dq)
         uc = np.einsum("jpin,n->jpi", geo.Jc, dq)
         work = np.sum(f * ub) - np.sum(f * uc)
-        assert c.forces(q) @ dq == pytest.approx(work, rel=1e-11, abs=1e-12 * np.abs(f).sum())
+        assert c.forces(q, SPIN) @ dq == pytest.approx(work, rel=1e-11, abs=1e-12 * np.abs(f).sum())
 
 
 @pytest.mark.parametrize("form", ["2D", "3D"])
 def test_action_reaction(model, crit, form):
     c, q = contact_state(model, crit, form)
-    f = c.point_forces(q)
-    R = c.resultant_on_casing(q)
+    f = c.point_forces(q, SPIN)
+    R = c.resultant_on_casing(q, SPIN)
     np.testing.assert_allclose(f.sum(axis=(0, 1)), -R, rtol=1e-14, atol=1e-12 * np.abs(f).sum())
     assert np.linalg.norm(R) > 0
-    Q = c.forces(q)
+    Q = c.forces(q, SPIN)
     # the generalised force on the casing translation is the resultant on the casing
     assert Q[model.index("casing.t.x")] == pytest.approx(R[0], rel=1e-12)
     assert Q[model.index("casing.t.y")] == pytest.approx(R[1], rel=1e-12)
@@ -389,7 +392,7 @@ def test_rigid_rotation_does_no_work(model, crit):
     """3D: tilting rotor and casing together as one rigid body (about the disk centre)
     moves no point relative to the other: moments balance as well as forces."""
     c, q = contact_state(model, crit, "3D")
-    Q = c.forces(q)
+    Q = c.forces(q, SPIN)
     sh = model.slices["shaft"]
     T, Rot = model.disk_maps
     A = np.vstack([T[:2, sh], Rot[:2, sh]])
@@ -417,8 +420,8 @@ def test_rigid_rotation_does_no_work(model, crit):
 
 def test_friction_torque_2d(model, crit):
     c, q = contact_state(model, crit, "2D")
-    FN = c.blade_forces(q)["F_N"]
-    tq = c.friction_torque_on_rotor(q)
+    FN = c.blade_forces(q, SPIN)["F_N"]
+    tq = c.friction_torque_on_rotor(q, SPIN)
     assert tq < 0
     R_tip = model.params.blades.tip_radius
     assert tq == pytest.approx(-c.mu * R_tip * FN.sum(), rel=1e-13)
@@ -426,8 +429,8 @@ def test_friction_torque_2d(model, crit):
 
 def test_friction_torque_3d_brakes(model, crit):
     c, q = contact_state(model, crit, "3D")
-    assert c.friction_torque_on_rotor(q) < 0
-    bf = c.blade_forces(q)
+    assert c.friction_torque_on_rotor(q, SPIN) < 0
+    bf = c.blade_forces(q, SPIN)
     np.testing.assert_allclose(bf["F_T"], c.mu * bf["F_N"])
 
 

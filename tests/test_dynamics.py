@@ -55,17 +55,17 @@ def test_static_residual_is_honest(model):
     omega = 3.4 * model.params.normalisation.omega_ref
     c = make_contact(model, "3D", g0=0.8e-3)
     st = solve_static(model, c, omega)
-    r = model.K_omega(omega) @ st.q - c.forces(st.q) - model.force(omega)
+    r = model.K_omega(omega) @ st.q - c.forces(st.q, omega) - model.force(omega)
     assert st.converged
     assert np.linalg.norm(r) <= 1e-9 * np.linalg.norm(model.force(omega))
     assert st.residual == pytest.approx(np.linalg.norm(r) / np.linalg.norm(model.force(omega)), rel=1e-3, abs=1e-14)
 
 
-def _modal_amplitude(model, omega, K_extra, lam, q, v):
+def _modal_amplitude(model, omega, K_extra, C_extra, lam, q, v):
     """Projection of the state (q, v) on the eigenvector of lam (left eigenvector)."""
     from rotorub_model.analyses.linear import first_order
 
-    A = first_order(model, omega, K_extra)
+    A = first_order(model, omega, K_extra, C_extra)
     w, vl = np.linalg.eig(A.T)
     k = np.argmin(np.abs(w - lam))
     return vl[:, k] @ np.concatenate([q, v], axis=-1).T
@@ -92,8 +92,8 @@ def test_unstable_2d_transient_grows_at_eigenvalue_rate(model):
     omega, c, st, sb = _unstable_2d_point(model)
     from rotorub_model.analyses.linear import first_order
 
-    Kx = c.jacobian(st.q)
-    lam_all, vec = np.linalg.eig(first_order(model, omega, Kx))
+    Kx, Cx = c.jacobians(st.q, omega)
+    lam_all, vec = np.linalg.eig(first_order(model, omega, Kx, Cx))
     k = np.argmax(lam_all.real)
     lam, v = lam_all[k], vec[:, k]
     assert lam.real == pytest.approx(sb.max_real)
@@ -111,7 +111,7 @@ def test_unstable_2d_transient_grows_at_eigenvalue_rate(model):
         assert np.all((c.gaps(qi) < 0) == (g_static < 0)), "contact set changed: not a linear test"
     qd = res.q - st.q
     vel = np.gradient(qd, res.t, axis=0)
-    a = np.abs(_modal_amplitude(model, omega, Kx, lam, qd, vel))
+    a = np.abs(_modal_amplitude(model, omega, Kx, Cx, lam, qd, vel))
     i0, i1 = len(res.t) // 4, len(res.t) - 2
     rate = np.log(a[i1] / a[i0]) / (res.t[i1] - res.t[i0])
     assert rate == pytest.approx(lam.real, rel=0.2), f"growth {rate:.4g} 1/s vs eigenvalue {lam.real:.4g} 1/s"
@@ -156,7 +156,7 @@ def test_time_step_guard(undamped):
     with pytest.raises(ParameterError, match="dt"):
         CentralDifference(m, c, dt=-1.0)
     # the guard is right: with every contact closed, just below the limit stays bounded, just above blows up
-    K = m.K + all_closed_stiffness(c)
+    K = m.K + all_closed_stiffness(c, 0.0)
     q0 = np.random.default_rng(2).normal(size=m.n_dofs) * 1e-6
     growth = []
     for f in (0.99, 1.01):

@@ -108,7 +108,7 @@ def test_quasi_static_mode_equals_static_solver(fmu, ref_model):
         assert st.converged
         q = st.q
         sb = stability_of(ref_model, c, float(w), q)
-        F_ref = c.outputs(q)["F_N"]
+        F_ref = c.outputs(q, float(w))["F_N"]
         assert np.abs(F - F_ref).max() <= 1e-9 * max(np.abs(F_ref).max(), 1.0)
         assert re == pytest.approx(sb.max_real, rel=1e-9, abs=1e-12)
         assert n == st.n_contact

@@ -21,9 +21,9 @@
 
 struct model_runtime {
     int formulation, mode, n, nb, np;
-    double g0, k_r, mu, theta, chord, dt_max, max_pen;
+    double g0, k_r, mu, theta, chord, dt_max, max_pen, v_slip;
     rr_geometry geo;
-    double *geo_mem, *res_F, *res_M, *tq_F, *tq_M, *cwork;
+    double *geo_mem, *cwork;
     rr_contact contact;
     /* transient */
     double *q, *qp;
@@ -37,7 +37,7 @@ struct model_runtime {
     double plan_h, plan_band, lim_band, lim;
     int plan_n, have_plan, have_lim;
     /* quasi-static */
-    double *qs, *Kw, *Fw, *swork, *Aeig, *Minv, *wr, *wi, *ework;
+    double *qs, *Kw, *Fw, *swork, *Aeig, *Minv, *wr, *wi, *ework, *Jv;
     int *siwork;
     int have_qs;
     double phi_qs;
@@ -76,7 +76,7 @@ static double critical_step(model_runtime *m, double w)
     rr_contact closed = m->contact;
     closed.g0 = -1.0;
     for (i = 0; i < n; ++i) zero[i] = 0.0;
-    rr_jacobian(&closed, zero, J);
+    rr_jacobian(&closed, zero, NULL, w, J, NULL);
     k_omega(d, w, Kc);
     for (i = 0; i < (int)nn; ++i) Kc[i] = Kc[i] + -J[i];
     for (i = 0; i < n; ++i)
@@ -120,11 +120,11 @@ model_runtime *model_configure(const model_values *v, char *msg, size_t len)
     m->chord = v->r[VR_CHORD];
     m->dt_max = v->r[VR_DT_MAX];
     m->max_pen = v->r[VR_MAX_PEN];
+    m->v_slip = v->r[VR_SLIP];
 
     /* contact geometry (the kernel's, from the ingredients baked at build time) */
-    m->geo_mem = (double *)zalloc((size_t)nb * P * (3 * 3 + 2 * 3 * n) + (size_t)nb * P * n + 4 * (size_t)nb * n +
-                                      2 * (size_t)n + 6 * (size_t)nb + 2 * (size_t)nb +
-                                      (size_t)rr_work_size(n, nb, np),
+    m->geo_mem = (double *)zalloc((size_t)nb * P * (3 * 3 + 2 * 3 * n) + 2 * (size_t)nb * P * n +
+                                      2 * (size_t)nb * n + 2 * (size_t)n + (size_t)rr_work_size(n, nb, np),
                                   sizeof(double));
     if (!m->geo_mem) goto oom;
     g = m->geo_mem;
@@ -137,13 +137,8 @@ model_runtime *model_configure(const model_values *v, char *msg, size_t len)
     TAKE(m->geo.G, (size_t)nb * P * n);
     TAKE(m->geo.A, (size_t)nb * n);
     TAKE(m->geo.B, (size_t)nb * n);
-    TAKE(m->geo.C, (size_t)nb * n);
-    TAKE(m->geo.D, (size_t)nb * n);
+    TAKE(m->geo.S, (size_t)nb * P * n);
     TAKE(m->geo.T2, 2 * (size_t)n);
-    TAKE(m->res_F, 3 * (size_t)nb);
-    TAKE(m->res_M, 3 * (size_t)nb);
-    TAKE(m->tq_F, (size_t)nb);
-    TAKE(m->tq_M, (size_t)nb);
     TAKE(m->cwork, (size_t)rr_work_size(n, nb, np));
 #undef TAKE
     spec.n = n;
@@ -168,8 +163,6 @@ model_runtime *model_configure(const model_values *v, char *msg, size_t len)
         model_free(m);
         return NULL;
     }
-    rr_contact_resultants(nb, np, np == 2 ? m->chord : 0.0, m->mu, m->geo.points, m->geo.normals, m->geo.tangents,
-                          m->res_F, m->res_M, m->tq_F, m->tq_M);
     m->contact.n = n;
     m->contact.nb = nb;
     m->contact.np = np;
@@ -180,12 +173,11 @@ model_runtime *model_configure(const model_values *v, char *msg, size_t len)
     m->contact.G = m->geo.G;
     m->contact.A = m->geo.A;
     m->contact.B = m->geo.B;
-    m->contact.C = m->geo.C;
-    m->contact.D = m->geo.D;
-    m->contact.res_F = m->res_F;
-    m->contact.res_M = m->res_M;
-    m->contact.tq_F = m->tq_F;
-    m->contact.tq_M = m->tq_M;
+    m->contact.v_slip = m->v_slip;
+    m->contact.S = m->geo.S;
+    m->contact.points = m->geo.points;
+    m->contact.normals = m->geo.normals;
+    m->contact.tangents = m->geo.tangents;
     m->contact.T2 = m->geo.T2;
     m->contact.work = m->cwork;
 
@@ -195,7 +187,7 @@ model_runtime *model_configure(const model_values *v, char *msg, size_t len)
     m->piv = (int *)zalloc((size_t)n, sizeof(int));
     /* quasi-static (and the step limit): q_static, K, F, static work, the 2n x 2n matrix, M^-1, eigenvalues */
     m->qs = (double *)zalloc((size_t)n + nn + (size_t)n + (size_t)rr_static_work_size(n) + 4 * nn + nn +
-                                 3 * 2 * (size_t)n,
+                                 3 * 2 * (size_t)n + nn,
                              sizeof(double));
     m->siwork = (int *)zalloc(2 * (size_t)n, sizeof(int));
     if (!m->q || !m->Ainv || !m->piv || !m->qs || !m->siwork) goto oom;
@@ -212,6 +204,7 @@ model_runtime *model_configure(const model_values *v, char *msg, size_t len)
     m->wr = m->Minv + nn;
     m->wi = m->wr + 2 * n;
     m->ework = m->wi + 2 * n;
+    m->Jv = m->ework + 2 * n;
     if (rr_inverse(n, d->M, m->Minv, m->Aeig, m->siwork) != 0) {
         snprintf(msg, len, "the mass matrix is singular");
         model_free(m);
@@ -351,18 +344,19 @@ static fmi2Status static_solution(model_runtime *m, model_values *v, double w, d
     double *J = m->K2, *A = m->Aeig, *C = m->Cm1;
     k_omega(d, w, m->Kw);
     for (i = 0; i < n; ++i) m->Fw[i] = me * w * w * d->f_unit[i];
-    ok = rr_static_solve(&m->contact, m->Kw, m->Fw, m->have_qs ? m->qs : NULL, 1e-10, 60, q, &rel, &its, m->swork,
+    ok = rr_static_solve(&m->contact, w, m->Kw, m->Fw, m->have_qs ? m->qs : NULL, 1e-10, 60, q, &rel, &its, m->swork,
                          m->siwork);
     if (!ok) {
         snprintf(msg, len, "no balanced static solution at Omega = %g rad/s, imbalance = %g kg.m, g0 = %g m "
                  "(relative residual %.2e); the outputs hold the last solution", w, me, m->g0, rel);
         return fmi2Discard;
     }
-    /* x' = A x, x = (q, q'): A = [[0, I], [-M^-1 (K(W) - J), -M^-1 (D + W G1)]] */
-    rr_jacobian(&m->contact, q, J);
+    /* x' = A x, x = (q, q'): A = [[0, I], [-M^-1 (K(W) - J), -M^-1 (D + W G1 - Jv)]] */
+    rr_jacobian(&m->contact, q, NULL, w, J, m->Jv);
     for (k = 0; k < (int)nn; ++k) {
         m->Kw[k] = m->Kw[k] - J[k];
         C[k] = d->D[k] + w * d->G1[k];
+        C[k] = C[k] - m->Jv[k];
     }
     for (i = 0; i < 2 * n; ++i)
         for (j = 0; j < 2 * n; ++j) A[(size_t)i * 2 * n + j] = 0.0;
@@ -387,7 +381,7 @@ static fmi2Status static_solution(model_runtime *m, model_values *v, double w, d
         if (m->wr[i] > max_real) max_real = m->wr[i];
     for (i = 0; i < n; ++i) m->qs[i] = q[i];
     m->have_qs = 1;
-    rr_outputs(&m->contact, m->qs, phi, OUTPUT_INDEX, v->r);
+    rr_outputs(&m->contact, m->qs, NULL, w, phi, OUTPUT_INDEX, v->r);
     finish_outputs(v, max_real);
     v->r[VR_DT_INTERNAL] = 0.0;
     v->i[VR_N_SUBSTEPS] = 0;
@@ -420,7 +414,7 @@ fmi2Status model_solve_now(model_runtime *m, model_values *v, char *msg, size_t 
     if (g0 != m->g0) set_clearance(m, g0);
     if (m->mode != MODE_QUASI_STATIC) {
         /* the outputs of the current state (transient: they do not depend on the inputs) */
-        rr_outputs(&m->contact, m->q, m->st.phi, OUTPUT_INDEX, v->r);
+        rr_outputs(&m->contact, m->q, NULL, v->r[VR_OMEGA], m->st.phi, OUTPUT_INDEX, v->r);
         finish_outputs(v, 0.0);
         return fmi2OK;
     }

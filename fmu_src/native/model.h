@@ -55,7 +55,7 @@ extern const model_data MODEL_DATA;
 /* value references the model reads and writes (fixed by fmu_src/interface.py; checked at build) */
 enum {
     VR_OMEGA, VR_IMBALANCE, VR_FORMULATION, VR_MODE, VR_PARAM_FILE, VR_G0, VR_K_R, VR_MU, VR_THETA, VR_CHORD,
-    VR_DT_MAX, VR_MAX_PEN
+    VR_DT_MAX, VR_MAX_PEN, VR_SLIP
 };
 extern const int VR_N_CONTACT, VR_MAX_REAL, VR_STATUS, VR_MESSAGE, VR_DT_INTERNAL, VR_N_SUBSTEPS;
 /* where the kernel's outputs of a state (its order, RR_N_OUT(nb)) go in the Real value array */

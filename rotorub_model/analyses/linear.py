@@ -136,17 +136,23 @@ def run_response(
     return ResponseResult(speeds, wref, amp, tilt, crit, pamp, ptilt, model.n_dofs)
 
 
-def first_order(model: Model, omega: float, K_extra: np.ndarray | None = None) -> np.ndarray:
-    """State matrix A of x' = A x, x = (q, q'), for M q'' + (D + G) q' + (K(W) - K_extra) q = 0."""
+def first_order(model: Model, omega: float, K_extra: np.ndarray | None = None,
+                C_extra: np.ndarray | None = None) -> np.ndarray:
+    """State matrix A of x' = A x, x = (q, q'), for
+    M q'' + (D + G - C_extra) q' + (K(W) - K_extra) q = 0 (K_extra, C_extra: the contact
+    force's Jacobians in q and q')."""
     n = model.n_dofs
     K = model.K_omega(omega)
     if K_extra is not None:
         K = K - K_extra
+    C = model.D + model.G(omega)
+    if C_extra is not None:
+        C = C - C_extra
     Minv = np.linalg.inv(model.M)
     A = np.zeros((2 * n, 2 * n))
     A[:n, n:] = np.eye(n)
     A[n:, :n] = -Minv @ K
-    A[n:, n:] = -Minv @ (model.D + model.G(omega))
+    A[n:, n:] = -Minv @ C
     return A
 
 

@@ -1,6 +1,8 @@
 """Stability of a balanced static solution (eq. 11).
 
-The perturbation obeys M q'' + (D + G(Omega)) q' + (K(Omega) - J F_nl(q0)) q = 0.
+The perturbation obeys M q'' + (D + G(Omega) - J_v) q' + (K(Omega) - J_q) q = 0, with J_q and
+J_v the contact force's Jacobians in q and q' at the static solution (J_v: the damping of the
+regularised friction, zero at tip speeds far above contact.slip_velocity).
 The solution is unstable if an eigenvalue of the first-order system has a positive
 real part. Indicators: the largest real part and the paper's "sum of positive real
 parts" (each complex-conjugate pair counted once, i.e. the sum over modes), plus
@@ -45,7 +47,8 @@ def stability_of(
     model: Model, contact: ContactModel, omega: float, q0: np.ndarray, n_dominant: int = 3
 ) -> StabilityResult:
     """Eigen-analysis of the system linearised about the static solution q0."""
-    A = first_order(model, omega, contact.jacobian(q0))
+    J, Jv = contact.jacobians(q0, omega)
+    A = first_order(model, omega, J, Jv)
     lam, vec = np.linalg.eig(A)
     keep = lam.imag >= -1e-9 * np.maximum(1.0, np.abs(lam))
     # real eigenvalues appear once; complex pairs once (Im >= 0)

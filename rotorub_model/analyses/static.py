@@ -92,7 +92,7 @@ def solve_static(
     # Newton, its starts and the imbalance continuation run in the kernel (one call): the FMUs'
     # quasi-static steps are the same code
     ok = bool(contact.lib.rr_static_solve(
-        contact.kernel, kernel.ptr(K), kernel.ptr(F), None if start is None else kernel.ptr(start), float(tol),
+        contact.kernel, float(omega), kernel.ptr(K), kernel.ptr(F), None if start is None else kernel.ptr(start), float(tol),
         int(max_iter), kernel.ptr(q), ctypes.byref(rel), ctypes.byref(its), kernel.ptr(work), kernel.iptr(iwork)))
     rel, its = rel.value, its.value
     if not ok and raise_on_failure:
@@ -100,7 +100,7 @@ def solve_static(
             f"static solution at omega={omega:g} rad/s, g0={contact.g0:g} m did not converge "
             f"(relative residual {rel:.2e} after {its} iterations)"
         )
-    bf = contact.blade_forces(q)
+    bf = contact.blade_forces(q, omega)
     return StaticResult(
         q=q,
         omega=float(omega),

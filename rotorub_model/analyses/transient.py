@@ -45,14 +45,14 @@ from ..results import pyplot, save_figure, write_json
 from ..structure.model import Model
 
 
-def all_closed_stiffness(contact: ContactModel) -> np.ndarray:
-    """Contact stiffness with every blade in full contact (-dF_nl/dq)."""
-    return -contact.with_clearance(-1.0).jacobian(np.zeros(contact.n_dofs))
+def all_closed_stiffness(contact: ContactModel, omega: float) -> np.ndarray:
+    """Contact stiffness with every blade in full contact (-dF_nl/dq) at spin omega."""
+    return -contact.with_clearance(-1.0).jacobian(np.zeros(contact.n_dofs), omega)
 
 
 def critical_time_step(model: Model, contact: ContactModel, omega: float) -> float:
     """2 / w_max of the linearised system with all contacts closed [s]."""
-    Kc = model.K_omega(omega) + all_closed_stiffness(contact)
+    Kc = model.K_omega(omega) + all_closed_stiffness(contact, omega)
     lam = kernel.eigenvalues(kernel.inverse(model.M) @ Kc)  # the FMUs' eigen-solver, so all pick the same step
     return 2.0 / math.sqrt(float(np.max(np.abs(lam))))
 
@@ -146,7 +146,11 @@ class CentralDifference:
                     n, *map(kernel.ptr, structure), float(omega), float(omega_dot), float(self.dt), kernel.ptr(Ainv),
                     kernel.ptr(K2), kernel.ptr(Cm1), kernel.ptr(work), kernel.iptr(piv)) != 0:
                 raise ParameterError(f"dt: {self.dt:g} s: the central-difference matrix is singular")
-            arrays = (Ainv, K2, Cm1, np.ascontiguousarray(m.force(omega, 1.0, omega_dot), dtype=float))
+            # the imbalance force per unit m e (scaled by the kernel) and the blades' own inertia
+            # load under dOmega/dt (not scaled: it does not depend on the imbalance)
+            f_me = omega * omega * m.f_unit + omega_dot * m.f_tangential
+            f0 = omega_dot * m.f_euler
+            arrays = (Ainv, K2, Cm1, np.ascontiguousarray(f_me, dtype=float), np.ascontiguousarray(f0, dtype=float))
             mats = kernel.RRMatrices(n, *map(kernel.ptr, arrays))
             self._mats = (mats, arrays)
             self._job.mats = ctypes.addressof(mats)
@@ -238,13 +242,15 @@ def rotate_to_fixed(v: np.ndarray, phi: np.ndarray | float) -> np.ndarray:
 
 
 def outputs_from_q(model: Model, contact: ContactModel, q: np.ndarray, phi: np.ndarray,
-                   rotating: np.ndarray | None = None) -> dict[str, np.ndarray]:
+                   rotating: np.ndarray | None = None, omega: float = 0.0,
+                   qdot: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Physical outputs for states q (nt, n) at frame angles phi (nt,).
 
     ``rotating``: the kernel's outputs of these states (rotating frame), if already
-    computed (the transient records them as it goes); else one batched kernel call.
+    computed (the transient records them as it goes); else one batched kernel call at spin
+    ``omega`` with velocities ``qdot`` (None: at rest in the rotating frame).
     """
-    o = contact.split_outputs(contact.outputs_array(q) if rotating is None else rotating)
+    o = contact.split_outputs(contact.outputs_array(q, omega, qdot) if rotating is None else rotating)
     cs = model.slices["casing"]
     casing = q[:, cs][:, :2]
     return {

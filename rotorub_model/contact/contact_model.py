@@ -15,14 +15,25 @@ curvature terms (order d^2 / R ~ 1e-5 m for millimetre motion) are dropped.
 
 Forces (virtual work of the pressure on the gap's derivatives; the laws run in the kernel):
 the normal pressure on the blade is -p_N n, on the casing +p_N n, so its virtual
-work is int p_N d gap(c) dc, and the friction pressure's is -int p_T dt(c) dc:
+work is int p_N d gap(c) dc. The pressure is statically equivalent to point weights
+w_p >= 0 at the contact points (2D: w = F_N; 3D: w_LE = F_N/2 - M_N/l, w_TE = F_N/2 + M_N/l).
 
-    Q = F_N d_eta/dq + M_N d_zeta/dq - (F_T d_tmid/dq + M_T d_tslope/dq),
-    F_T = mu F_N, M_T = mu M_N (k_t = mu k_r, friction opposes the blade's sliding
-    along +e_t, i.e. the spin direction),
+Friction acts at each point against its sliding velocity. In the rotating frame the blade
+point slides over the casing along e_t at
 
-so Q includes the reactions on the casing (its J_c enters with the opposite sign):
-action equals reaction by construction, which the tests check on physical forces.
+    v_p = Omega rho_p + S_p q',   rho_p = (e_z x r_p) . e_t,   S_p = e_t . (J_b - J_c)
+
+(the rigid rotation, plus the blade's and the casing's vibration), and the friction force on
+the blade is -mu tanh(v_p / v_slip) w_p e_t (on the casing the opposite). v_slip is
+``contact.slip_velocity`` (0.1 m/s): at the paper's tip speeds tanh = 1 to the last bit and the
+law is exact Coulomb, mu F_N against the spin; near v = 0 (start from rest, run-down,
+windmilling, a vibration at Omega = 0) the friction turns with the sliding and dissipates.
+The generalised force
+
+    Q = F_N d_eta/dq + M_N d_zeta/dq - sum_p mu tanh(v_p / v_slip) w_p S_p
+
+includes the reactions on the casing (its J_c enters with the opposite sign): action equals
+reaction by construction, which the tests check on physical forces.
 """
 
 from __future__ import annotations
@@ -61,25 +72,16 @@ class ContactModel:
     g0: float
     k_r: float
     mu: float
+    v_slip: float = 0.1
     G: np.ndarray = field(init=False)  # (N*P, n) gap gradients (the geometry's)
     A: np.ndarray = field(init=False)  # (N, n) d eta / dq
     B: np.ndarray = field(init=False)  # (N, n) d zeta / dq
-    C: np.ndarray = field(init=False)  # (N, n) d t_mid / dq
-    D: np.ndarray = field(init=False)  # (N, n) d t_slope / dq
+    S: np.ndarray = field(init=False)  # (N*P, n) sliding rows e_t . (J_b - J_c)
 
     def __post_init__(self) -> None:
         g = self.geometry
         self.n_blades, self.n_points = g.points.shape[:2]
-        self.G, self.A, self.B, self.C, self.D = g.G, g.A, g.B, g.C, g.D
-        # The casing resultant and the rotor torque are linear in (F_N, M_N) of each blade:
-        # maps built once (by the kernel, with this mu) so per-state outputs cost two small products.
-        N = self.n_blades
-        self._res_F, self._res_M = np.zeros((N, 3)), np.zeros((N, 3))
-        self._tq_F, self._tq_M = np.zeros(N), np.zeros(N)
-        pts = [np.ascontiguousarray(a, dtype=float) for a in (g.points, g.normals, g.tangents)]  # alive: named
-        kernel.load().rr_contact_resultants(
-            N, self.n_points, float(g.chord), float(self.mu), *map(kernel.ptr, pts),
-            *map(kernel.ptr, (self._res_F, self._res_M, self._tq_F, self._tq_M)))
+        self.G, self.A, self.B, self.S = g.G, g.A, g.B, g.S
         self._k = None
 
     # ------------------------------------------------------------------ the kernel's view
@@ -87,14 +89,14 @@ class ContactModel:
     def kernel(self) -> kernel.RRContact:
         """The kernel's rr_contact struct of this model (its arrays are pinned on the object)."""
         if self._k is None:
+            g = self.geometry
             arrays = [np.ascontiguousarray(a, dtype=float) for a in (
-                self.G, self.A, self.B, self.C, self.D, self._res_F, self._res_M, self._tq_F, self._tq_M,
-                self.geometry.disk)]
+                self.G, self.A, self.B, self.S, g.points, g.normals, g.tangents, g.disk)]
             self._lib = kernel.load()
             work = np.zeros(self._lib.rr_work_size(self.n_dofs, self.n_blades, self.n_points))
             self._pinned = (*arrays, work)
             self._k = kernel.RRContact(self.n_dofs, self.n_blades, self.n_points, float(self.g0), float(self.k_r),
-                                       float(self.mu), float(max(self.geometry.chord, 1e-300)),
+                                       float(self.mu), float(max(self.geometry.chord, 1e-300)), float(self.v_slip),
                                        *map(kernel.ptr, self._pinned))
         return self._k
 
@@ -121,7 +123,7 @@ class ContactModel:
 
     def with_clearance(self, g0: float) -> ContactModel:
         """Same geometry, another nominal clearance (cheap: gaps are affine)."""
-        return ContactModel(self.formulation, self.variant, self.geometry, g0, self.k_r, self.mu)
+        return ContactModel(self.formulation, self.variant, self.geometry, g0, self.k_r, self.mu, self.v_slip)
 
     def _eval(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         q = np.ascontiguousarray(q, dtype=float)
@@ -139,20 +141,55 @@ class ContactModel:
         """Per blade (N, 7): F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction."""
         return self._eval(q)[1]
 
-    def forces(self, q: np.ndarray) -> np.ndarray:
-        """Generalised contact force vector F_nl(q) (on rotor and casing dofs)."""
-        q = np.ascontiguousarray(q, dtype=float)
+    @staticmethod
+    def _velocity(qdot: np.ndarray | None) -> np.ndarray | None:
+        return None if qdot is None else np.ascontiguousarray(qdot, dtype=float)
+
+    def friction_factors(self, q: np.ndarray, omega: float, qdot: np.ndarray | None = None) -> np.ndarray:
+        """mu tanh(v_p / v_slip) at every contact point (N, P) (0 where the blade does not touch);
+        ``qdot`` None: the state is at rest in the rotating frame (a static solution)."""
+        q, qd = np.ascontiguousarray(q, dtype=float), self._velocity(qdot)
+        fr = np.empty((self.n_blades, self.n_points))
+        k = self.kernel
+        self._lib.rr_friction(k, kernel.ptr(q), None if qd is None else kernel.ptr(qd), float(omega), kernel.ptr(fr))
+        return fr
+
+    def sliding_velocity(self, omega: float, qdot: np.ndarray | None = None) -> np.ndarray:
+        """v_p = Omega rho_p + S_p q' (N, P) [m/s]: how fast each blade point slides over the casing
+        along e_t (positive in the spin direction), at the rest geometry (small displacements:
+        the state q does not enter)."""
+        g = self.geometry
+        rho = g.points[..., 0] * g.tangents[..., 1] - g.points[..., 1] * g.tangents[..., 0]
+        v = omega * rho
+        if qdot is not None:
+            v = v + (self.S @ np.asarray(qdot, dtype=float)).reshape(self.n_blades, self.n_points)
+        return v
+
+    def forces(self, q: np.ndarray, omega: float, qdot: np.ndarray | None = None) -> np.ndarray:
+        """Generalised contact force vector F_nl(q, q'; Omega) (on rotor and casing dofs)."""
+        q, qd = np.ascontiguousarray(q, dtype=float), self._velocity(qdot)
         f = np.empty(self.n_dofs)
         k = self.kernel
-        self._lib.rr_force(k, kernel.ptr(q), kernel.ptr(f))
+        self._lib.rr_force(k, kernel.ptr(q), None if qd is None else kernel.ptr(qd), float(omega), kernel.ptr(f))
         return f
 
-    def jacobian(self, q: np.ndarray) -> np.ndarray:
-        """Analytic d F_nl / d q (not symmetric when mu > 0)."""
-        q = np.ascontiguousarray(q, dtype=float)
+    def jacobians(self, q: np.ndarray, omega: float, qdot: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Analytic (d F_nl / d q, d F_nl / d q'): the stiffness (not symmetric when friction acts)
+        and the damping of the regularised friction (symmetric, negative semi-definite)."""
+        q, qd = np.ascontiguousarray(q, dtype=float), self._velocity(qdot)
+        J, Jv = np.empty((self.n_dofs, self.n_dofs)), np.empty((self.n_dofs, self.n_dofs))
+        k = self.kernel
+        self._lib.rr_jacobian(k, kernel.ptr(q), None if qd is None else kernel.ptr(qd), float(omega), kernel.ptr(J),
+                              kernel.ptr(Jv))
+        return J, Jv
+
+    def jacobian(self, q: np.ndarray, omega: float, qdot: np.ndarray | None = None) -> np.ndarray:
+        """Analytic d F_nl / d q (not symmetric when friction acts)."""
+        q, qd = np.ascontiguousarray(q, dtype=float), self._velocity(qdot)
         J = np.empty((self.n_dofs, self.n_dofs))
         k = self.kernel
-        self._lib.rr_jacobian(k, kernel.ptr(q), kernel.ptr(J))
+        self._lib.rr_jacobian(k, kernel.ptr(q), None if qd is None else kernel.ptr(qd), float(omega), kernel.ptr(J),
+                              None)
         return J
 
     def gaps_batch(self, Q: np.ndarray) -> np.ndarray:
@@ -163,24 +200,40 @@ class ContactModel:
         self._lib.rr_gaps_batch(k, int(Q.shape[0]), kernel.ptr(Q), kernel.ptr(out))
         return out
 
-    def blade_forces(self, q: np.ndarray) -> dict[str, np.ndarray]:
-        """Per-blade outputs: F_N, F_T, M_N, M_T [N, N m], gaps, chord fraction in contact."""
+    def blade_forces(self, q: np.ndarray, omega: float, qdot: np.ndarray | None = None) -> dict[str, np.ndarray]:
+        """Per-blade outputs: F_N, F_T (friction, positive against the spin), M_N, M_T [N, N m],
+        gaps, chord fraction in contact."""
         g, L = self._eval(q)
+        fr = self.friction_factors(q, omega, qdot)
+        w = self._weights(L)
+        arm = np.array([-0.5, 0.5]) * self.geometry.chord if self.n_points == 2 else np.zeros(1)
         return {
             "F_N": L[:, 0].copy(),
-            "F_T": self.mu * L[:, 0],
+            "F_T": np.sum(fr * w, axis=1),
             "M_N": L[:, 1].copy(),
-            "M_T": self.mu * L[:, 1],
+            "M_T": np.sum(fr * w * arm, axis=1),
             "gap": g,
             "fraction": L[:, 6].copy(),
         }
 
-    def outputs_array(self, Q: np.ndarray) -> np.ndarray:
-        """The kernel's outputs of states Q (m, n) or q (n), rotating frame: (m, n_outputs)."""
+    def _weights(self, L: np.ndarray) -> np.ndarray:
+        """Point weights w_p (N, P) of the laws L: the normal force each point carries."""
+        FN, MN = L[:, 0], L[:, 1]
+        if self.n_points == 2:
+            return np.stack([0.5 * FN - MN / self.geometry.chord, 0.5 * FN + MN / self.geometry.chord], axis=1)
+        return FN[:, None].copy()
+
+    def outputs_array(self, Q: np.ndarray, omega: float, Qdot: np.ndarray | None = None) -> np.ndarray:
+        """The kernel's outputs of states Q (m, n) or q (n) with velocities Qdot (same shape, None:
+        at rest in the rotating frame) at spin speed omega, rotating frame: (m, n_outputs)."""
         Q = np.ascontiguousarray(np.atleast_2d(Q), dtype=float)
+        Qd = None if Qdot is None else np.ascontiguousarray(np.atleast_2d(Qdot), dtype=float)
+        if Qd is not None and Qd.shape != Q.shape:
+            raise ValueError(f"Qdot: shape {Qd.shape} differs from Q's {Q.shape}")
         out = np.empty((Q.shape[0], self.n_outputs))
         k = self.kernel
-        self._lib.rr_outputs_batch(k, int(Q.shape[0]), kernel.ptr(Q), kernel.ptr(out))
+        self._lib.rr_outputs_batch(k, int(Q.shape[0]), kernel.ptr(Q), None if Qd is None else kernel.ptr(Qd),
+                                   float(omega), kernel.ptr(out))
         return out
 
     def split_outputs(self, out: np.ndarray) -> dict[str, np.ndarray]:
@@ -198,41 +251,40 @@ class ContactModel:
             "gap_min": gl["gap_min"], "n_contact": gl["n_contact"].astype(int),
         }
 
-    def write_outputs(self, q: np.ndarray, phi: float, index: np.ndarray, dest: np.ndarray) -> None:
-        """The outputs of state q, fixed frame at angle phi, written to dest[index[k]] (an FMU's
-        value buffer; ``index``: intc array in the kernel's order, ``dest``: float64)."""
-        q = np.ascontiguousarray(q, dtype=float)
+    def write_outputs(self, q: np.ndarray, qdot: np.ndarray | None, omega: float, phi: float, index: np.ndarray,
+                      dest: np.ndarray) -> None:
+        """The outputs of state (q, q') at spin omega, fixed frame at angle phi, written to
+        dest[index[k]] (an FMU's value buffer; ``index``: intc array in the kernel's order,
+        ``dest``: float64)."""
+        q, qd = np.ascontiguousarray(q, dtype=float), self._velocity(qdot)
         k = self.kernel
-        self._lib.rr_outputs(k, kernel.ptr(q), float(phi), kernel.iptr(index), kernel.ptr(dest))
+        self._lib.rr_outputs(k, kernel.ptr(q), None if qd is None else kernel.ptr(qd), float(omega), float(phi),
+                             kernel.iptr(index), kernel.ptr(dest))
 
-    def outputs(self, q: np.ndarray) -> dict[str, np.ndarray | float]:
+    def outputs(self, q: np.ndarray, omega: float, qdot: np.ndarray | None = None) -> dict[str, np.ndarray | float]:
         """Everything an output needs at one state, with the contact law evaluated once:
         per blade F_N, F_T, gap (N, P), fraction; the casing resultant (rotating frame),
         the friction torque on the rotor (same values as :meth:`resultant_on_casing`
         and :meth:`friction_torque_on_rotor`), the fan-disk displacement, the smallest gap."""
-        o = self.split_outputs(self.outputs_array(q))
+        o = self.split_outputs(self.outputs_array(q, omega, None if qdot is None else np.atleast_2d(qdot)))
         return {k: float(v[0]) if v.ndim == 1 else v[0] for k, v in o.items()}
 
-    def point_forces(self, q: np.ndarray) -> np.ndarray:
+    def point_forces(self, q: np.ndarray, omega: float, qdot: np.ndarray | None = None) -> np.ndarray:
         """Physical forces on the blade at each contact point (N, P, 3), statically
         equivalent to the distributed pressure (linear along the chord)."""
-        L = self.laws(q)
-        FN, MN = L[:, 0], L[:, 1]
+        w = self._weights(self.laws(q))
+        fr = self.friction_factors(q, omega, qdot)
         g = self.geometry
-        if self.n_points == 2:
-            w = np.stack([0.5 * FN - MN / g.chord, 0.5 * FN + MN / g.chord], axis=1)
-        else:
-            w = FN[:, None]
-        return -(w[..., None] * g.normals) - self.mu * (w[..., None] * g.tangents)
+        return -(w[..., None] * g.normals) - (fr * w)[..., None] * g.tangents
 
-    def resultant_on_casing(self, q: np.ndarray) -> np.ndarray:
+    def resultant_on_casing(self, q: np.ndarray, omega: float, qdot: np.ndarray | None = None) -> np.ndarray:
         """Total contact force on the casing, rotating-frame components (3,)."""
-        return -self.point_forces(q).sum(axis=(0, 1))
+        return -self.point_forces(q, omega, qdot).sum(axis=(0, 1))
 
-    def friction_torque_on_rotor(self, q: np.ndarray) -> float:
+    def friction_torque_on_rotor(self, q: np.ndarray, omega: float, qdot: np.ndarray | None = None) -> float:
         """Axial torque of the contact forces on the rotor about the spin axis [N m]
         (negative: it brakes the spin)."""
-        f = self.point_forces(q)
+        f = self.point_forces(q, omega, qdot)
         r = self.geometry.points
         return float(np.sum(r[..., 0] * f[..., 1] - r[..., 1] * f[..., 0]))
 
@@ -240,7 +292,7 @@ class ContactModel:
 def make_contact(model: Model, formulation: str = "3D", variant: str = "full", **overrides) -> ContactModel:
     """Contact model of ``formulation`` ('2D' or '3D') and 3D ``variant``.
 
-    ``overrides`` replace contact parameters (g0, k_r, mu, theta_deg, chord).
+    ``overrides`` replace contact parameters (g0, k_r, mu, theta_deg, chord, slip_velocity).
     Variants (paper section 4): 'full'; 'kinematics_only' (theta = 0, l_c = 1 mm);
     'geometry_only' (no disk or casing rotation, no blade flexure in the gap).
     """
@@ -251,7 +303,7 @@ def make_contact(model: Model, formulation: str = "3D", variant: str = "full", *
     if formulation == "2D" and variant != "full":
         raise ParameterError(f"variant: '{variant}' applies to the 3D formulation only; accepted for 2D: full")
     c = model.params.contact
-    known = {"g0", "k_r", "mu", "theta_deg", "chord"}
+    known = {"g0", "k_r", "mu", "theta_deg", "chord", "slip_velocity"}
     bad = set(overrides) - known
     if bad:
         raise ParameterError(f"contact.{sorted(bad)[0]}: unknown; accepted: {', '.join(sorted(known))}")
@@ -264,4 +316,4 @@ def make_contact(model: Model, formulation: str = "3D", variant: str = "full", *
         if variant == "kinematics_only":
             theta, chord = 0.0, 1e-3
         geo = geometry_3d(model, theta, chord, rotations=variant != "geometry_only")
-    return ContactModel(formulation, variant, geo, c.g0, c.k_r, c.mu)
+    return ContactModel(formulation, variant, geo, c.g0, c.k_r, c.mu, c.slip_velocity)

@@ -34,8 +34,7 @@ class ContactGeometry:
     G: np.ndarray  # (N*P, n) gap gradients: gap = g0 + G q
     A: np.ndarray  # (N, n) d eta / dq (mean gap along the chord)
     B: np.ndarray  # (N, n) d zeta / dq (gap slope)
-    C: np.ndarray  # (N, n) d t_mid / dq (sliding, mean)
-    D: np.ndarray  # (N, n) d t_slope / dq
+    S: np.ndarray  # (N*P, n) sliding rows e_t . (J_b - J_c): relative sliding along e_t = S q
 
 
 def geometry_spec(model: Model, n_points: int, theta: float, chord: float, rotations: bool) -> dict:
@@ -65,10 +64,10 @@ def build_geometry(model: Model, n_points: int, theta: float = 0.0, chord: float
         kernel.ptr(s["T"]), kernel.ptr(s["Rot"]))
     out = {k: np.zeros(shape) for k, shape in (
         ("points", (N, P, 3)), ("normals", (N, P, 3)), ("tangents", (N, P, 3)), ("Jb", (N, P, 3, n)),
-        ("Jc", (N, P, 3, n)), ("G", (N * P, n)), ("A", (N, n)), ("B", (N, n)), ("C", (N, n)), ("D", (N, n)),
+        ("Jc", (N, P, 3, n)), ("G", (N * P, n)), ("A", (N, n)), ("B", (N, n)), ("S", (N * P, n)),
         ("disk", (2, n)))}
     geo = kernel.RRGeometry(*(kernel.ptr(out[k]) for k in ("points", "normals", "tangents", "Jb", "Jc", "G", "A",
-                                                            "B", "C", "D", "disk")))
+                                                            "B", "S", "disk")))
     if lib.rr_contact_geometry(ctypes.byref(spec), ctypes.byref(geo)) != 0:
         raise ValueError(f"contact geometry: invalid specification (points {P}, chord {chord!r} m)")
     return ContactGeometry(chord=float(chord if P == 2 else 0.0), **out)

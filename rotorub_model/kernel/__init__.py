@@ -29,7 +29,7 @@ from .compiler import CFLAGS, CompilerError, compile_shared, host_platform_tag, 
 HERE = Path(__file__).resolve().parent
 SOURCES = (HERE / "rotorub_kernel.c",)
 HEADER = HERE / "rotorub_kernel.h"
-ABI_VERSION = 4
+ABI_VERSION = 5
 LAW_WIDTH = 7
 OUT_BLADE_BLOCKS = 6
 OUT_GLOBALS = 8
@@ -47,8 +47,8 @@ _ip = ctypes.c_void_p
 class RRContact(ctypes.Structure):
     _fields_ = [("n", ctypes.c_int), ("nb", ctypes.c_int), ("np", ctypes.c_int), ("g0", ctypes.c_double),
                 ("k_r", ctypes.c_double), ("mu", ctypes.c_double), ("chord", ctypes.c_double),
-                ("G", _dp), ("A", _dp), ("B", _dp), ("C", _dp), ("D", _dp), ("res_F", _dp), ("res_M", _dp),
-                ("tq_F", _dp), ("tq_M", _dp), ("T2", _dp), ("work", _dp)]
+                ("v_slip", ctypes.c_double), ("G", _dp), ("A", _dp), ("B", _dp), ("S", _dp), ("points", _dp),
+                ("normals", _dp), ("tangents", _dp), ("T2", _dp), ("work", _dp)]
 
 
 class RRGeometrySpec(ctypes.Structure):
@@ -60,12 +60,11 @@ class RRGeometrySpec(ctypes.Structure):
 
 
 class RRGeometry(ctypes.Structure):
-    _fields_ = [(name, _dp) for name in ("points", "normals", "tangents", "Jb", "Jc", "G", "A", "B", "C", "D",
-                                         "T2")]
+    _fields_ = [(name, _dp) for name in ("points", "normals", "tangents", "Jb", "Jc", "G", "A", "B", "S", "T2")]
 
 
 class RRMatrices(ctypes.Structure):
-    _fields_ = [("n", ctypes.c_int), ("Ainv", _dp), ("K2", _dp), ("Cm1", _dp), ("f", _dp)]
+    _fields_ = [("n", ctypes.c_int), ("Ainv", _dp), ("K2", _dp), ("Cm1", _dp), ("f", _dp), ("f0", _dp)]
 
 
 class RRState(ctypes.Structure):
@@ -119,9 +118,6 @@ def _declare(lib: ctypes.CDLL) -> ctypes.CDLL:
     lib.rr_work_size.restype = ctypes.c_int
     lib.rr_contact_geometry.argtypes = [ctypes.c_void_p, ctypes.c_void_p]
     lib.rr_contact_geometry.restype = ctypes.c_int
-    lib.rr_contact_resultants.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_double, ctypes.c_double, _dp, _dp,
-                                          _dp, _dp, _dp, _dp, _dp]
-    lib.rr_contact_resultants.restype = None
     lib.rr_lu.argtypes = [ctypes.c_int, _dp, _ip]
     lib.rr_lu.restype = ctypes.c_int
     lib.rr_lu_solve.argtypes = [ctypes.c_int, _dp, _ip, _dp]
@@ -135,20 +131,22 @@ def _declare(lib: ctypes.CDLL) -> ctypes.CDLL:
     lib.rr_cd_build.restype = ctypes.c_int
     lib.rr_static_work_size.argtypes = [ctypes.c_int]
     lib.rr_static_work_size.restype = ctypes.c_int
-    lib.rr_static_solve.argtypes = [ctypes.POINTER(RRContact), _dp, _dp, _dp, ctypes.c_double, ctypes.c_int, _dp,
+    lib.rr_static_solve.argtypes = [ctypes.POINTER(RRContact), ctypes.c_double, _dp, _dp, _dp, ctypes.c_double,
+                                    ctypes.c_int, _dp,
                                     ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_int), _dp, _ip]
     lib.rr_static_solve.restype = ctypes.c_int
     lib.rr_blade_law.argtypes = [ctypes.c_int, ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_double,
                                  _dp]
     lib.rr_laws.argtypes = [c, _dp, _dp, _dp]
-    lib.rr_force.argtypes = [c, _dp, _dp]
-    lib.rr_jacobian.argtypes = [c, _dp, _dp]
+    lib.rr_friction.argtypes = [c, _dp, _dp, ctypes.c_double, _dp]
+    lib.rr_force.argtypes = [c, _dp, _dp, ctypes.c_double, _dp]
+    lib.rr_jacobian.argtypes = [c, _dp, _dp, ctypes.c_double, _dp, _dp]
     lib.rr_gaps_batch.argtypes = [c, ctypes.c_int, _dp, _dp]
-    lib.rr_outputs.argtypes = [c, _dp, ctypes.c_double, _ip, _dp]
-    lib.rr_outputs_batch.argtypes = [c, ctypes.c_int, _dp, _dp]
+    lib.rr_outputs.argtypes = [c, _dp, _dp, ctypes.c_double, ctypes.c_double, _ip, _dp]
+    lib.rr_outputs_batch.argtypes = [c, ctypes.c_int, _dp, _dp, ctypes.c_double, _dp]
     lib.rr_cd_run.argtypes = [ctypes.c_void_p]
     lib.rr_cd_run.restype = ctypes.c_int
-    for name in ("rr_blade_law", "rr_laws", "rr_force", "rr_jacobian", "rr_gaps_batch", "rr_outputs",
+    for name in ("rr_blade_law", "rr_laws", "rr_friction", "rr_force", "rr_jacobian", "rr_gaps_batch", "rr_outputs",
                  "rr_outputs_batch"):
         getattr(lib, name).restype = None
     return lib

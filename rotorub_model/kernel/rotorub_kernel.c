@@ -12,8 +12,8 @@ int rr_abi_version(void) { return RR_ABI_VERSION; }
 
 const char *rr_source_id(void) { return RR_SOURCE_ID; }
 
-/* scratch: gaps (nb*np) + law (nb*7) + right-hand side (n) */
-int rr_work_size(int n, int nb, int np) { return nb * np + nb * RR_LAW_WIDTH + n; }
+/* scratch: gaps (nb*np) + law (nb*7) + friction (nb*np) + right-hand side (n) */
+int rr_work_size(int n, int nb, int np) { return nb * np + nb * RR_LAW_WIDTH + nb * np + n; }
 
 /* ------------------------------------------------------------------ geometry */
 
@@ -114,62 +114,23 @@ int rr_contact_geometry(const rr_geometry_spec *s, rr_geometry *o)
             for (e = 0; e < n; ++e) {
                 double r0 = Jb[e] - Jc[e], r1 = Jb[n + e] - Jc[n + e], r2 = Jb[2 * n + e] - Jc[2 * n + e];
                 double g = -(nv[0] * r0 + nv[1] * r1 + nv[2] * r2);
-                double tt = tv[0] * r0 + tv[1] * r1 + tv[2] * r2;
                 o->G[pk * n + e] = g;
+                o->S[pk * n + e] = tv[0] * r0 + tv[1] * r1 + tv[2] * r2;
                 if (np == 1) {
                     o->A[(size_t)j * n + e] = g;
                     o->B[(size_t)j * n + e] = 0.0;
-                    o->C[(size_t)j * n + e] = tt;
-                    o->D[(size_t)j * n + e] = 0.0;
                 } else if (k == 0) {
                     o->A[(size_t)j * n + e] = g; /* completed with the TE below */
-                    o->C[(size_t)j * n + e] = tt;
                 } else {
-                    double gle = o->A[(size_t)j * n + e], tle = o->C[(size_t)j * n + e];
+                    double gle = o->A[(size_t)j * n + e];
                     o->A[(size_t)j * n + e] = 0.5 * (gle + g);
                     o->B[(size_t)j * n + e] = (g - gle) / s->chord;
-                    o->C[(size_t)j * n + e] = 0.5 * (tle + tt);
-                    o->D[(size_t)j * n + e] = (tt - tle) / s->chord;
                 }
             }
         }
     }
     for (r = 0; r < 2 * n; ++r) o->T2[r] = s->T[r];
     return 0;
-}
-
-void rr_contact_resultants(int nb, int np, double chord, double mu, const double *points, const double *normals,
-                           const double *tangents, double *res_F, double *res_M, double *tq_F, double *tq_M)
-{
-    int j, i;
-    double cl = chord > 1e-300 ? chord : 1e-300;
-    for (j = 0; j < nb; ++j) {
-        double f[2][3], arm[2];
-        int k;
-        for (k = 0; k < np; ++k) {
-            const double *P = points + 3 * (j * np + k), *nv = normals + 3 * (j * np + k);
-            const double *tv = tangents + 3 * (j * np + k);
-            /* force on the casing per unit weight (normal + friction along the sliding), and its
-             * torque on the rotor about the spin axis */
-            for (i = 0; i < 3; ++i) f[k][i] = nv[i] + mu * tv[i];
-            arm[k] = -(P[0] * f[k][1] - P[1] * f[k][0]);
-        }
-        if (np == 2) {
-            for (i = 0; i < 3; ++i) {
-                res_F[3 * j + i] = 0.5 * (f[0][i] + f[1][i]);
-                res_M[3 * j + i] = (f[1][i] - f[0][i]) / cl;
-            }
-            tq_F[j] = 0.5 * (arm[0] + arm[1]);
-            tq_M[j] = (arm[1] - arm[0]) / cl;
-        } else {
-            for (i = 0; i < 3; ++i) {
-                res_F[3 * j + i] = f[0][i];
-                res_M[3 * j + i] = 0.0;
-            }
-            tq_F[j] = arm[0];
-            tq_M[j] = 0.0;
-        }
-    }
 }
 
 /* ------------------------------------------------------------------ laws */
@@ -264,41 +225,124 @@ void rr_gaps_batch(const rr_contact *c, int m, const double *Q, double *gaps)
     for (i = 0; i < m; ++i) gaps_of(c, Q + (size_t)i * c->n, gaps + (size_t)i * rows);
 }
 
-/* Q = A^T F_N + B^T M_N - mu (C^T F_N + D^T M_N): the virtual work of the pressure on the
- * gap's derivatives, reactions on the casing included (through the casing part of G). */
-void rr_force(const rr_contact *c, const double *q, double *f)
+/* ------------------------------------------------------------------ friction */
+
+/* Share of the blade's normal force carried by each contact point: the pressure p(c) >= 0 on
+ * [-l/2, l/2] is statically equivalent to w_LE = F/2 - M/l at the LE and w_TE = F/2 + M/l at
+ * the TE (both >= 0); dw/dF and dw/dM are (1/2, -1/l) and (1/2, 1/l). 2D: w = F_N. */
+static void point_weights(int np, double l, double FN, double MN, double *w, double *aF, double *aM)
 {
-    int j, k, n = c->n, nb = c->nb;
-    double *gaps = c->work, *law = c->work + nb * c->np;
-    rr_laws(c, q, gaps, law);
-    for (k = 0; k < n; ++k) {
-        double a = 0.0, b = 0.0, cc = 0.0, d = 0.0;
-        for (j = 0; j < nb; ++j) {
-            double FN = law[RR_LAW_WIDTH * j], MN = law[RR_LAW_WIDTH * j + 1];
-            size_t o = (size_t)j * n + k;
-            a += c->A[o] * FN;
-            b += c->B[o] * MN;
-            cc += c->C[o] * FN;
-            d += c->D[o] * MN;
-        }
-        f[k] = a + b - c->mu * (cc + d);
+    if (np == 2) {
+        w[0] = 0.5 * FN - MN / l;
+        w[1] = 0.5 * FN + MN / l;
+        aF[0] = 0.5;
+        aF[1] = 0.5;
+        aM[0] = -1.0 / l;
+        aM[1] = 1.0 / l;
+    } else {
+        w[0] = FN;
+        aF[0] = 1.0;
+        aM[0] = 0.0;
     }
 }
 
-void rr_jacobian(const rr_contact *c, const double *q, double *J)
+/* (e_z x r).e_t: the sliding speed of the point per unit spin (its radius for e_t = e_theta) */
+static double spin_arm(const double *P, const double *t) { return P[0] * t[1] - P[1] * t[0]; }
+
+/* Friction factors mu tanh(v_p / v_slip) of every point of a blade in contact, from the law at q;
+ * the velocity is qdot, or (q - q_prev) / dt when qdot is NULL and q_prev is not, or zero. */
+static void friction_of(const rr_contact *c, const double *law, double omega, const double *qdot, const double *q,
+                        const double *q_prev, double dt, double *fr)
 {
-    int j, r, k, n = c->n, nb = c->nb;
-    double *gaps = c->work, *law = c->work + nb * c->np;
+    int j, p, e, n = c->n, np = c->np;
+    for (j = 0; j < c->nb; ++j) {
+        const double *L = law + RR_LAW_WIDTH * j;
+        int touching = !(L[0] == 0.0 && L[1] == 0.0);
+        for (p = 0; p < np; ++p) {
+            size_t pk = (size_t)j * np + p;
+            double v;
+            if (!touching) {
+                fr[pk] = 0.0;
+                continue;
+            }
+            v = omega * spin_arm(c->points + 3 * pk, c->tangents + 3 * pk);
+            if (qdot || q_prev) {
+                const double *S = c->S + pk * n;
+                double sv = 0.0;
+                if (qdot)
+                    for (e = 0; e < n; ++e) sv += S[e] * qdot[e];
+                else
+                    for (e = 0; e < n; ++e) sv += S[e] * (q[e] - q_prev[e]);
+                v += qdot ? sv : sv / dt;
+            }
+            fr[pk] = c->mu * tanh(v / c->v_slip);
+        }
+    }
+}
+
+void rr_friction(const rr_contact *c, const double *q, const double *qdot, double omega, double *fr)
+{
+    double *gaps = c->work, *law = c->work + c->nb * c->np;
     rr_laws(c, q, gaps, law);
+    friction_of(c, law, omega, qdot, NULL, NULL, 1.0, fr);
+}
+
+/* Q = A^T F_N + B^T M_N - sum_p f_p w_p S_p^T: the virtual work of the normal pressure on the gap's
+ * derivatives and of the friction on the sliding, reactions on the casing included (through the
+ * casing part of G and S). */
+static void force_from_law(const rr_contact *c, const double *law, const double *fr, double *f)
+{
+    int j, k, p, n = c->n, np = c->np;
+    for (k = 0; k < n; ++k) f[k] = 0.0;
+    for (j = 0; j < c->nb; ++j) {
+        const double *L = law + RR_LAW_WIDTH * j;
+        const double *A = c->A + (size_t)j * n, *B = c->B + (size_t)j * n;
+        double w[2], aF[2], aM[2];
+        if (L[0] == 0.0 && L[1] == 0.0) continue;
+        point_weights(np, c->chord, L[0], L[1], w, aF, aM);
+        for (k = 0; k < n; ++k) f[k] += A[k] * L[0] + B[k] * L[1];
+        for (p = 0; p < np; ++p) {
+            size_t pk = (size_t)j * np + p;
+            const double *S = c->S + pk * n;
+            double fw = fr[pk] * w[p];
+            if (fw != 0.0)
+                for (k = 0; k < n; ++k) f[k] -= fw * S[k];
+        }
+    }
+}
+
+void rr_force(const rr_contact *c, const double *q, const double *qdot, double omega, double *f)
+{
+    int nb = c->nb, rows = nb * c->np;
+    double *gaps = c->work, *law = gaps + rows, *fr = law + nb * RR_LAW_WIDTH;
+    rr_laws(c, q, gaps, law);
+    friction_of(c, law, omega, qdot, NULL, NULL, 1.0, fr);
+    force_from_law(c, law, fr, f);
+}
+
+void rr_jacobian(const rr_contact *c, const double *q, const double *qdot, double omega, double *J, double *Jv)
+{
+    int j, r, k, p, e, n = c->n, nb = c->nb, np = c->np, rows = nb * np;
+    double *gaps = c->work, *law = gaps + rows, *fr = law + nb * RR_LAW_WIDTH;
+    rr_laws(c, q, gaps, law);
+    friction_of(c, law, omega, qdot, NULL, NULL, 1.0, fr);
     for (r = 0; r < n * n; ++r) J[r] = 0.0;
+    if (Jv)
+        for (r = 0; r < n * n; ++r) Jv[r] = 0.0;
     for (j = 0; j < nb; ++j) {
         const double *L = law + RR_LAW_WIDTH * j;
         const double *A = c->A + (size_t)j * n, *B = c->B + (size_t)j * n;
-        const double *C = c->C + (size_t)j * n, *D = c->D + (size_t)j * n;
+        const double *S0 = c->S + (size_t)j * np * n, *S1 = np == 2 ? S0 + n : S0;
+        double w[2], aF[2], aM[2], f0, f1;
         if (L[2] == 0.0 && L[3] == 0.0 && L[4] == 0.0 && L[5] == 0.0) continue;
+        point_weights(np, c->chord, L[0], L[1], w, aF, aM);
+        f0 = fr[(size_t)j * np];
+        f1 = np == 2 ? fr[(size_t)j * np + 1] : 0.0;
         for (r = 0; r < n; ++r) {
-            /* row r of A^T dF + B^T dM - mu (C^T dF + D^T dM), dF = L2 A + L3 B, dM = L4 A + L5 B */
-            double wF = A[r] - c->mu * C[r], wM = B[r] - c->mu * D[r];
+            /* row r of A^T dF + B^T dM - sum_p f_p S_p^T dw_p, dw_p = aF_p dF + aM_p dM,
+             * dF = L2 A + L3 B, dM = L4 A + L5 B */
+            double wF = A[r] - (f0 * aF[0] * S0[r] + (np == 2 ? f1 * aF[1] * S1[r] : 0.0));
+            double wM = B[r] - (f0 * aM[0] * S0[r] + (np == 2 ? f1 * aM[1] * S1[r] : 0.0));
             double *Jr = J + (size_t)r * n;
             if (wF == 0.0 && wM == 0.0) continue;
             for (k = 0; k < n; ++k) {
@@ -307,36 +351,61 @@ void rr_jacobian(const rr_contact *c, const double *q, double *J)
                 Jr[k] += wF * dF + wM * dM;
             }
         }
+        if (!Jv) continue;
+        /* d/dq' of -mu tanh(v_p / v_slip) w_p S_p^T, v_p = omega rho_p + S_p q' */
+        for (p = 0; p < np; ++p) {
+            size_t pk = (size_t)j * np + p;
+            const double *S = c->S + pk * n;
+            double th, cpl;
+            if (c->mu == 0.0 || w[p] == 0.0) continue;
+            th = fr[pk] / c->mu;
+            cpl = c->mu * w[p] * (1.0 - th * th) / c->v_slip;
+            if (cpl == 0.0) continue;
+            for (r = 0; r < n; ++r) {
+                double a = cpl * S[r];
+                if (a == 0.0) continue;
+                for (e = 0; e < n; ++e) Jv[(size_t)r * n + e] -= a * S[e];
+            }
+        }
     }
 }
 
 /* ------------------------------------------------------------------ outputs of a state */
 
 static void outputs_from_law(const rr_contact *c, const double *q, const double *gaps, const double *law,
-                             double phi, const int *index, double *dest)
+                             const double *fr, double phi, const int *index, double *dest)
 {
-    int j, k, nb = c->nb, np = c->np, n = c->n;
-    double Fc[3] = {0.0, 0.0, 0.0}, Mc[3] = {0.0, 0.0, 0.0}, tF = 0.0, tM = 0.0;
+    int j, k, p, nb = c->nb, np = c->np, n = c->n;
+    double Fc[3] = {0.0, 0.0, 0.0}, torque = 0.0;
     double dx = 0.0, dy = 0.0, gmin = HUGE_VAL, cs, sn, vals[RR_OUT_GLOBALS];
     int n_contact = 0;
 #define RR_PUT(pos, value) (index ? (dest[index[(pos)]] = (value)) : (dest[(pos)] = (value)))
     for (j = 0; j < nb; ++j) {
         const double *L = law + RR_LAW_WIDTH * j;
-        double FN = L[0], MN = L[1];
+        double FN = L[0], MN = L[1], FT = 0.0, w[2], aF[2], aM[2];
         double gle = gaps[np * j], gte = gaps[np * j + np - 1];
         double gtip = (gle <= gte || gle != gle) ? gle : gte; /* a NaN propagates, as numpy's min */
+        if (!(FN == 0.0 && MN == 0.0)) {
+            point_weights(np, c->chord, FN, MN, w, aF, aM);
+            for (p = 0; p < np; ++p) {
+                /* on the casing: w_p (n_p + f_p t_p); its torque on the rotor about e_z is the opposite */
+                size_t pk = (size_t)j * np + p;
+                const double *P = c->points + 3 * pk, *nv = c->normals + 3 * pk, *tv = c->tangents + 3 * pk;
+                double f[3];
+                for (k = 0; k < 3; ++k) {
+                    f[k] = w[p] * (nv[k] + fr[pk] * tv[k]);
+                    Fc[k] += f[k];
+                }
+                torque -= P[0] * f[1] - P[1] * f[0];
+                FT += fr[pk] * w[p];
+            }
+        }
         RR_PUT(RR_OUT_FN * nb + j, FN);
-        RR_PUT(RR_OUT_FT * nb + j, c->mu * FN);
+        RR_PUT(RR_OUT_FT * nb + j, FT);
         RR_PUT(RR_OUT_GAP_LE * nb + j, gle);
         RR_PUT(RR_OUT_GAP_TE * nb + j, gte);
         RR_PUT(RR_OUT_GAP_TIP * nb + j, gtip);
         RR_PUT(RR_OUT_FRACTION * nb + j, L[6]);
-        for (k = 0; k < 3; ++k) {
-            Fc[k] += FN * c->res_F[3 * j + k];
-            Mc[k] += MN * c->res_M[3 * j + k];
-        }
-        tF += FN * c->tq_F[j];
-        tM += MN * c->tq_M[j];
         if (FN > 0.0) ++n_contact;
         if (gtip < gmin || gtip != gtip) gmin = gtip;
     }
@@ -346,13 +415,10 @@ static void outputs_from_law(const rr_contact *c, const double *q, const double 
     }
     cs = cos(phi);
     sn = sin(phi);
-    Fc[0] += Mc[0];
-    Fc[1] += Mc[1];
-    Fc[2] += Mc[2];
     vals[RR_OUT_CASING_X] = cs * Fc[0] - sn * Fc[1];
     vals[RR_OUT_CASING_Y] = sn * Fc[0] + cs * Fc[1];
     vals[RR_OUT_CASING_Z] = Fc[2];
-    vals[RR_OUT_TORQUE] = tF + tM;
+    vals[RR_OUT_TORQUE] = torque;
     vals[RR_OUT_DISK_X] = cs * dx - sn * dy;
     vals[RR_OUT_DISK_Y] = sn * dx + cs * dy;
     vals[RR_OUT_GAP_MIN] = gmin;
@@ -361,41 +427,53 @@ static void outputs_from_law(const rr_contact *c, const double *q, const double 
 #undef RR_PUT
 }
 
-void rr_outputs(const rr_contact *c, const double *q, double phi, const int *index, double *dest)
+void rr_outputs(const rr_contact *c, const double *q, const double *qdot, double omega, double phi,
+                const int *index, double *dest)
 {
-    double *gaps = c->work, *law = c->work + c->nb * c->np;
+    int rows = c->nb * c->np;
+    double *gaps = c->work, *law = gaps + rows, *fr = law + c->nb * RR_LAW_WIDTH;
     rr_laws(c, q, gaps, law);
-    outputs_from_law(c, q, gaps, law, phi, index, dest);
+    friction_of(c, law, omega, qdot, NULL, NULL, 1.0, fr);
+    outputs_from_law(c, q, gaps, law, fr, phi, index, dest);
 }
 
-void rr_outputs_batch(const rr_contact *c, int m, const double *Q, double *out)
+void rr_outputs_batch(const rr_contact *c, int m, const double *Q, const double *Qdot, double omega, double *out)
 {
     int i;
-    for (i = 0; i < m; ++i) rr_outputs(c, Q + (size_t)i * c->n, 0.0, NULL, out + (size_t)i * RR_N_OUT(c->nb));
+    for (i = 0; i < m; ++i)
+        rr_outputs(c, Q + (size_t)i * c->n, Qdot ? Qdot + (size_t)i * c->n : NULL, omega, 0.0, NULL,
+                   out + (size_t)i * RR_N_OUT(c->nb));
 }
 
 /* ------------------------------------------------------------------ central differences */
 
-/* One step: (M/dt^2 + C/2dt) q+ = r F + F_nl(q) + (2M/dt^2 - K) q - (M/dt^2 - C/2dt) q-, with the
- * contact force at the current q only (explicit), from the laws already evaluated at q. The order
- * of the sums is fixed (see the header); locals and restrict let the compiler keep the matrices
- * streaming instead of reloading the structs after every store. */
-static void cd_update(int n, int nb, const double *restrict law, const double *restrict A,
-                      const double *restrict B, const double *restrict C, const double *restrict D, double mu,
+/* One step: (M/dt^2 + C/2dt) q+ = r F + F0 + F_nl(q, q') + (2M/dt^2 - K) q - (M/dt^2 - C/2dt) q-,
+ * with the contact force at the current state only (explicit; q' = (q - q-)/dt for the friction),
+ * from the laws and friction factors already evaluated there. The order of the sums is fixed (see
+ * the header); locals and restrict let the compiler keep the matrices streaming instead of
+ * reloading the structs after every store. */
+static void cd_update(int n, int nb, int np, double l, const double *restrict law, const double *restrict fr,
+                      const double *restrict A, const double *restrict B, const double *restrict S,
                       const double *restrict Ainv, const double *restrict K2, const double *restrict Cm1,
-                      const double *restrict f, double r, double *restrict q, double *restrict qp,
-                      double *restrict rhs)
+                      const double *restrict f, const double *restrict f0, double r, double *restrict q,
+                      double *restrict qp, double *restrict rhs)
 {
     int j, k, e;
+    for (k = 0; k < n; ++k) rhs[k] = f0 ? r * f[k] + f0[k] : r * f[k];
+    for (j = 0; j < nb; ++j) {
+        const double *L = law + RR_LAW_WIDTH * j;
+        const double *Aj = A + (size_t)j * n, *Bj = B + (size_t)j * n;
+        const double *S0 = S + (size_t)j * np * n, *S1 = S0 + (np == 2 ? n : 0);
+        double FN = L[0], MN = L[1], w[2], aF[2], aM[2], c0, c1;
+        if (FN == 0.0 && MN == 0.0) continue; /* adds an exact zero */
+        point_weights(np, l, FN, MN, w, aF, aM);
+        c0 = fr[(size_t)j * np] * w[0];
+        c1 = np == 2 ? fr[(size_t)j * np + 1] * w[1] : 0.0;
+        for (k = 0; k < n; ++k) rhs[k] += Aj[k] * FN + Bj[k] * MN - (c0 * S0[k] + c1 * S1[k]);
+    }
     for (k = 0; k < n; ++k) {
-        double acc = r * f[k];
         const double *K2k = K2 + (size_t)k * n, *Cm1k = Cm1 + (size_t)k * n;
-        for (j = 0; j < nb; ++j) {
-            double FN = law[RR_LAW_WIDTH * j], MN = law[RR_LAW_WIDTH * j + 1];
-            size_t o = (size_t)j * n + k;
-            if (FN == 0.0 && MN == 0.0) continue; /* adds an exact zero */
-            acc += A[o] * FN + B[o] * MN - mu * (C[o] * FN + D[o] * MN);
-        }
+        double acc = rhs[k];
         for (e = 0; e < n; ++e) acc += K2k[e] * q[e] - Cm1k[e] * qp[e];
         rhs[k] = acc;
     }
@@ -408,8 +486,8 @@ static void cd_update(int n, int nb, const double *restrict law, const double *r
     }
 }
 
-/* The law is evaluated once per state: at the end of a step it serves both the record of the
- * new state and the next step's contact force. */
+/* The law and the friction are evaluated once per state: at the end of a step they serve both the
+ * record of the new state and the next step's contact force. */
 int rr_cd_run(rr_cd_job *job)
 {
     rr_cd_state *s = job->state;
@@ -417,15 +495,16 @@ int rr_cd_run(rr_cd_job *job)
     const rr_cd_matrices *m = job->mats;
     int i, k, n = c->n, nb = c->nb, rows = nb * c->np;
     int done = 0, written = job->n_rec, rec_every = job->rec_every < 1 ? 1 : job->rec_every;
-    double *gaps = c->work, *law = c->work + rows;
-    double *rhs = law + nb * RR_LAW_WIDTH;
+    double *gaps = c->work, *law = gaps + rows, *fr = law + nb * RR_LAW_WIDTH, *rhs = fr + rows;
     double *q = s->q, *qp = s->q_prev;
     const double t0 = s->t, dt = s->dt, floor_gap = -s->max_pen, t_ramp = job->t_ramp, me = job->me;
+    const double omega = job->omega;
     const long long step0 = s->steps;
     job->done = 0;
     if (s->diverged) return 0;
     gaps_of(c, q, gaps);
     laws_of(c, gaps, law);
+    friction_of(c, law, omega, NULL, q, qp, dt, fr);
     for (i = 0; i < job->n_steps; ++i) {
         double t = t0 + i * dt;
         double r = (t_ramp <= 0.0 || t >= t_ramp) ? 1.0 : t / t_ramp;
@@ -436,23 +515,25 @@ int rr_cd_run(rr_cd_job *job)
             s->diverged = 1;
             break;
         }
-        cd_update(n, nb, law, c->A, c->B, c->C, c->D, c->mu, m->Ainv, m->K2, m->Cm1, m->f, r * me, q, qp, rhs);
+        cd_update(n, nb, c->np, c->chord, law, fr, c->A, c->B, c->S, m->Ainv, m->K2, m->Cm1, m->f, m->f0, r * me,
+                  q, qp, rhs);
         ++done;
         gaps_of(c, q, gaps);
         laws_of(c, gaps, law);
+        friction_of(c, law, omega, NULL, q, qp, dt, fr);
         if ((step0 + i + 1) % rec_every == 0 && written < job->rec_cap) {
             for (k = 0; k < n; ++k) job->rec_q[(size_t)written * n + k] = q[k];
             if (job->rec_out)
-                outputs_from_law(c, q, gaps, law, 0.0, NULL, job->rec_out + (size_t)written * RR_N_OUT(nb));
+                outputs_from_law(c, q, gaps, law, fr, 0.0, NULL, job->rec_out + (size_t)written * RR_N_OUT(nb));
             ++written;
         }
     }
     s->steps += done;
     s->t += done * dt;
-    s->phi += done * dt * job->omega;
+    s->phi += done * dt * omega;
     job->n_rec = written;
     job->done = done;
-    if (job->out_dest) outputs_from_law(c, q, gaps, law, s->phi, job->out_index, job->out_dest);
+    if (job->out_dest) outputs_from_law(c, q, gaps, law, fr, s->phi, job->out_index, job->out_dest);
     return done;
 }
 
@@ -779,11 +860,11 @@ static double norm2(int n, const double *x)
 }
 
 /* R = K x - F_nl(x) - lam F; returns |R| */
-static double residual(const rr_contact *c, int n, const double *K, const double *F, double lam, const double *x,
-                       double *R, double *fnl)
+static double residual(const rr_contact *c, double omega, int n, const double *K, const double *F, double lam,
+                       const double *x, double *R, double *fnl)
 {
     int i, j;
-    rr_force(c, x, fnl);
+    rr_force(c, x, NULL, omega, fnl);
     for (i = 0; i < n; ++i) {
         double s = 0.0;
         for (j = 0; j < n; ++j) s += K[(size_t)i * n + j] * x[j];
@@ -793,7 +874,7 @@ static double residual(const rr_contact *c, int n, const double *K, const double
 }
 
 /* Newton from q (overwritten); returns 1 if converged; *rel = |R|/scale, *its += iterations. */
-static int newton(const rr_contact *c, int n, const double *K, const double *F, double lam, double knorm,
+static int newton(const rr_contact *c, double omega, int n, const double *K, const double *F, double lam, double knorm,
                   double tol, int max_iter, double *q, double *rel, int *its, double *work, int *piv)
 {
     double *J = work, *R = work + (size_t)n * n, *fnl = R + n, *dq = fnl + n, *qn = dq + n, *Rn = qn + n;
@@ -804,7 +885,7 @@ static int newton(const rr_contact *c, int n, const double *K, const double *F, 
     scale = norm2(n, R);
     if (1e-12 * knorm > scale) scale = 1e-12 * knorm;
     if (1e-30 > scale) scale = 1e-30;
-    nr = residual(c, n, K, F, lam, q, R, fnl);
+    nr = residual(c, omega, n, K, F, lam, q, R, fnl);
     for (it = 1; it <= max_iter; ++it) {
         double step = 1.0, nn = 0.0;
         if (nr <= tol * scale) {
@@ -812,7 +893,7 @@ static int newton(const rr_contact *c, int n, const double *K, const double *F, 
             *its += it - 1;
             return 1;
         }
-        rr_jacobian(c, q, J);
+        rr_jacobian(c, q, NULL, omega, J, NULL);
         for (i = 0; i < n; ++i)
             for (j = 0; j < n; ++j) J[(size_t)i * n + j] = K[(size_t)i * n + j] - J[(size_t)i * n + j];
         if (rr_lu(n, J, piv) != 0) break;
@@ -820,7 +901,7 @@ static int newton(const rr_contact *c, int n, const double *K, const double *F, 
         rr_lu_solve(n, J, piv, dq);
         while (step > 1e-6) {
             for (i = 0; i < n; ++i) qn[i] = q[i] + step * dq[i];
-            nn = residual(c, n, K, F, lam, qn, Rn, fnl);
+            nn = residual(c, omega, n, K, F, lam, qn, Rn, fnl);
             if (nn < (1.0 - 1e-4 * step) * nr) break;
             step *= 0.5;
         }
@@ -840,8 +921,9 @@ static int newton(const rr_contact *c, int n, const double *K, const double *F, 
     return nr <= tol * scale;
 }
 
-int rr_static_solve(const rr_contact *c, const double *K, const double *F, const double *q0, double tol,
-                    int max_iter, double *q, double *residual_out, int *iterations, double *work, int *iwork)
+int rr_static_solve(const rr_contact *c, double omega, const double *K, const double *F, const double *q0,
+                    double tol, int max_iter, double *q, double *residual_out, int *iterations, double *work,
+                    int *iwork)
 {
     int n = c->n, i, j, k, ok = 0, its = 0, n_start;
     double *nw = work;                               /* newton: n*n + 5n */
@@ -880,7 +962,7 @@ int rr_static_solve(const rr_contact *c, const double *K, const double *F, const
                 rr_contact closed = *c;
                 closed.g0 = -1.0;
                 for (i = 0; i < n; ++i) start[i] = 0.0;
-                rr_jacobian(&closed, start, Kc);
+                rr_jacobian(&closed, start, NULL, omega, Kc, NULL);
                 for (i = 0; i < n * n; ++i) Kc[i] = -Kc[i];
                 have_kc = 1;
             }
@@ -892,7 +974,7 @@ int rr_static_solve(const rr_contact *c, const double *K, const double *F, const
             for (i = 0; i < n; ++i) start[i] = scales[kk - 5] * qlin[i];
         }
         for (i = 0; i < n; ++i) q[i] = start[i];
-        ok = newton(c, n, K, F, 1.0, knorm, tol, max_iter, q, &rel, &its, nw, iwork);
+        ok = newton(c, omega, n, K, F, 1.0, knorm, tol, max_iter, q, &rel, &its, nw, iwork);
         if (rel < best_rel) {
             best_rel = rel;
             for (i = 0; i < n; ++i) best[i] = q[i];
@@ -904,7 +986,7 @@ int rr_static_solve(const rr_contact *c, const double *K, const double *F, const
         for (i = 0; i < n; ++i) q[i] = 0.0;
         for (k = 0; k < 10; ++k) {
             double lam = k == 9 ? 1.0 : k * dlam + 0.1;
-            ok = newton(c, n, K, F, lam, knorm, tol, max_iter, q, &rel, &its, nw, iwork);
+            ok = newton(c, omega, n, K, F, lam, knorm, tol, max_iter, q, &rel, &its, nw, iwork);
             if (!ok) break;
         }
         if (!ok) {

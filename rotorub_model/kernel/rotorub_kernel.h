@@ -5,8 +5,9 @@
  *
  * What it holds:
  *   - the contact laws: 2D point law and 3D chord law (eq. 5-8 of Parent, Thouverez &
- *     Chevillot 2014) with Coulomb friction, their projection on the generalised
- *     coordinates and the Jacobian the static and stability solvers use;
+ *     Chevillot 2014) with Coulomb friction along the sliding velocity of each contact point
+ *     (regularised near zero), their projection on the generalised coordinates and the
+ *     Jacobians (in q and in q') the static and stability solvers use;
  *   - the outputs of a state (per-blade forces, gaps, chord fraction; casing resultant,
  *     friction torque, fan-disk displacement, smallest gap, blades in contact);
  *   - the explicit central-difference substep loop on dense matrices.
@@ -16,7 +17,10 @@
  * Matrices are dense, row-major, double precision. Nothing here allocates memory.
  *
  * Conventions (docs/THEORY.md): SI units; gaps positive when open; F_N >= 0 is the
- * magnitude of the normal force; friction F_T = mu F_N opposes the spin.
+ * magnitude of the normal force. Friction: at contact point p the blade slides over the casing
+ * along e_t at v_p = omega rho_p + S_p q' (rho_p = (e_z x r_p).e_t, S_p = e_t.(J_b - J_c)); the
+ * friction force on the blade is -mu tanh(v_p / v_slip) w_p e_t, w_p >= 0 the point's share of
+ * the normal force. Spin and sliding are positive along +e_t (the spin direction).
  *
  * Floating-point: the arithmetic is written in a fixed order and must be compiled
  * without contraction to FMA or reassociation (-ffp-contract=off, no -ffast-math), so
@@ -46,7 +50,7 @@ extern "C" {
 #endif
 
 /* Bumped whenever a struct layout or a signature below changes. */
-#define RR_ABI_VERSION 4
+#define RR_ABI_VERSION 5
 
 /* Per-blade law values (rr_laws): F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction. */
 #define RR_LAW_WIDTH 7
@@ -54,7 +58,7 @@ extern "C" {
 /* Layout of the outputs of a state (rr_outputs): six per-blade blocks, then globals. */
 enum {
     RR_OUT_FN = 0,       /* normal force per blade [N] */
-    RR_OUT_FT = 1,       /* friction force per blade, mu F_N [N] */
+    RR_OUT_FT = 1,       /* friction force per blade, opposing the spin when positive [N] */
     RR_OUT_GAP_LE = 2,   /* gap at the leading edge (2D: the tip gap) [m] */
     RR_OUT_GAP_TE = 3,   /* gap at the trailing edge (2D: the tip gap) [m] */
     RR_OUT_GAP_TIP = 4,  /* smallest gap of the blade [m] */
@@ -81,15 +85,14 @@ typedef struct {
     double k_r;       /* normal stiffness of a whole blade tip [N/m] */
     double mu;        /* Coulomb friction coefficient */
     double chord;     /* chord length l_c [m] (any positive value for np = 1) */
+    double v_slip;    /* velocity scale of the friction regularisation tanh(v / v_slip) [m/s] (> 0) */
     const double *G;  /* (nb*np, n) gap gradients: gap = g0 + G q */
     const double *A;  /* (nb, n) d eta / dq   (mean gap along the chord) */
     const double *B;  /* (nb, n) d zeta / dq  (gap slope along the chord) */
-    const double *C;  /* (nb, n) d t_mid / dq (sliding displacement, mean) */
-    const double *D;  /* (nb, n) d t_slope / dq */
-    const double *res_F; /* (nb, 3) casing resultant per unit F_N (rotating frame) */
-    const double *res_M; /* (nb, 3) casing resultant per unit M_N */
-    const double *tq_F;  /* (nb) torque on the rotor per unit F_N */
-    const double *tq_M;  /* (nb) torque on the rotor per unit M_N */
+    const double *S;  /* (nb*np, n) sliding rows: relative sliding along e_t at each point = S q */
+    const double *points;   /* (nb*np, 3) rest positions of the contact points (rotating frame) */
+    const double *normals;  /* (nb*np, 3) outward casing normals */
+    const double *tangents; /* (nb*np, 3) sliding directions e_t */
     const double *T2;    /* (2, n) fan-disk translation (rotating frame) */
     double *work;        /* scratch of at least rr_work_size(n, nb, np) doubles */
 } rr_contact;
@@ -124,7 +127,8 @@ typedef struct {
     double *Jb;       /* (nb, P, 3, n) displacement of the blade point */
     double *Jc;       /* (nb, P, 3, n) displacement of the casing point facing it */
     double *G;        /* (nb*P, n) gap gradients */
-    double *A, *B, *C, *D; /* (nb, n) d eta, d zeta, d t_mid, d t_slope / dq */
+    double *A, *B;    /* (nb, n) d eta, d zeta / dq */
+    double *S;        /* (nb*P, n) sliding rows e_t.(J_b - J_c) */
     double *T2;       /* (2, n) fan-disk translation */
 } rr_geometry;
 
@@ -134,7 +138,8 @@ typedef struct {
     const double *Ainv;  /* (n, n) */
     const double *K2;    /* (n, n) */
     const double *Cm1;   /* (n, n) */
-    const double *f;     /* (n) imbalance force at the full m e */
+    const double *f;     /* (n) imbalance force per unit m e [N / (kg m)] */
+    const double *f0;    /* (n) load independent of the imbalance (blade inertia under dOmega/dt) [N], or NULL */
 } rr_cd_matrices;
 
 /* State of the two-step scheme. q and q_prev are owned by the caller. */
@@ -157,28 +162,31 @@ RR_API int rr_work_size(int n, int nb, int np);
 /* Build the contact geometry of eq. (1) (2D) or eq. (3)-(4) linearised (3D; see docs/THEORY.md 4).
  * Returns 0, or -1 if the spec is invalid (np not 1 or 2, chord <= 0 in 3D). */
 RR_API int rr_contact_geometry(const rr_geometry_spec *spec, rr_geometry *out);
-/* The casing resultant and the rotor torque per unit F_N and M_N of each blade (linear maps,
- * with friction mu): res_F, res_M (nb, 3), tq_F, tq_M (nb). */
-RR_API void rr_contact_resultants(int nb, int np, double chord, double mu, const double *points,
-                                  const double *normals, const double *tangents, double *res_F, double *res_M,
-                                  double *tq_F, double *tq_M);
 /* The law of one blade from its gaps: np = 2 chord law (g_le, g_te), np = 1 point law (g_le). */
 RR_API void rr_blade_law(int np, double g_le, double g_te, double k, double l, double *out);
 /* Gaps (nb*np) and per-blade law values (nb x RR_LAW_WIDTH) at q. */
 RR_API void rr_laws(const rr_contact *c, const double *q, double *gaps, double *law);
-/* Generalised contact force F_nl(q) (n). */
-RR_API void rr_force(const rr_contact *c, const double *q, double *f);
-/* Jacobian dF_nl/dq (n x n, row-major; not symmetric when mu > 0). */
-RR_API void rr_jacobian(const rr_contact *c, const double *q, double *J);
+/* Friction factors mu tanh(v_p / v_slip) of the nb*np points at (q, q', omega) (0 where the blade
+ * does not touch); qdot NULL: at rest in the rotating frame (a static state). */
+RR_API void rr_friction(const rr_contact *c, const double *q, const double *qdot, double omega, double *fr);
+/* Generalised contact force F_nl(q, q'; omega) (n); qdot NULL: q' = 0. */
+RR_API void rr_force(const rr_contact *c, const double *q, const double *qdot, double omega, double *f);
+/* Jacobians dF_nl/dq (J) and dF_nl/dq' (Jv, or NULL), n x n row-major; J is not symmetric
+ * when friction acts, Jv is the (negative semi-definite) damping of the regularised friction. */
+RR_API void rr_jacobian(const rr_contact *c, const double *q, const double *qdot, double omega, double *J,
+                        double *Jv);
 /* Gaps of m states Q (m x n) into gaps (m x nb*np). */
 RR_API void rr_gaps_batch(const rr_contact *c, int m, const double *Q, double *gaps);
 
-/* The RR_N_OUT(nb) outputs of state q, casing force and disk displacement rotated by phi
- * (phi = 0: rotating frame). If index is NULL they are written to dest[0..], else
- * dest[index[k]] = output k (straight into an FMU's value buffer). */
-RR_API void rr_outputs(const rr_contact *c, const double *q, double phi, const int *index, double *dest);
-/* Outputs of m states (m x n) in the rotating frame, into out (m x RR_N_OUT(nb)). */
-RR_API void rr_outputs_batch(const rr_contact *c, int m, const double *Q, double *out);
+/* The RR_N_OUT(nb) outputs of state (q, q') at spin omega, casing force and disk displacement
+ * rotated by phi (phi = 0: rotating frame). If index is NULL they are written to dest[0..], else
+ * dest[index[k]] = output k (straight into an FMU's value buffer). qdot NULL: q' = 0. */
+RR_API void rr_outputs(const rr_contact *c, const double *q, const double *qdot, double omega, double phi,
+                       const int *index, double *dest);
+/* Outputs of m states Q (m x n) with velocities Qdot (m x n, or NULL) at spin omega, rotating
+ * frame, into out (m x RR_N_OUT(nb)). */
+RR_API void rr_outputs_batch(const rr_contact *c, int m, const double *Q, const double *Qdot, double omega,
+                             double *out);
 
 /* One call of the time loop: what to advance, with what, and where to put the results. A caller
  * that steps often (an FMU) keeps one job and only changes n_steps, omega and me between calls. */
@@ -200,8 +208,8 @@ typedef struct {
     int done;             /* out: steps done (fewer than n_steps if the run diverged) */
 } rr_cd_job;
 
-/* Advance job->n_steps central-difference steps at constant matrices, imbalance force
- * f * me * r(t). Returns the steps done; fewer than n_steps if a gap fell below -max_pen or a
+/* Advance job->n_steps central-difference steps at constant matrices, external force
+ * f * me * r(t) + f0; the friction of each step uses the velocity (q - q_prev) / dt. Returns the steps done; fewer than n_steps if a gap fell below -max_pen or a
  * value stopped being finite (state->diverged is then set and further calls do nothing). */
 RR_API int rr_cd_run(rr_cd_job *job);
 
@@ -220,7 +228,8 @@ RR_API int rr_eigenvalues(int n, double *A, double *wr, double *wi, double *work
 /* ------------------------------------------------------------------ balanced static solutions */
 /* Doubles and ints of scratch rr_static_solve needs. */
 RR_API int rr_static_work_size(int n);
-/* Balanced static solution of K q = F_nl(q) + F (eq. 10), K the stiffness K(Omega): Newton with
+/* Balanced static solution of K q = F_nl(q) + F (eq. 10) at spin omega (q' = 0: the points slide at
+ * omega rho_p), K the stiffness K(Omega): Newton with
  * the analytic contact Jacobian, LU, and a backtracking line search on |R|, tried from a list of
  * starts until one converges (|R| <= tol |F|): q0 (if not NULL), the linear response, the
  * responses with every contact closed at full, half and a tenth of its stiffness, the linear
@@ -228,8 +237,9 @@ RR_API int rr_static_work_size(int n);
  * If none converges, q is the start with the smallest residual. Returns 1 (converged) or 0;
  * *residual = |R| / |F|, *iterations = Newton iterations in all. work: rr_static_work_size(n)
  * doubles, iwork: n ints. The contact's work buffer is used too. */
-RR_API int rr_static_solve(const rr_contact *c, const double *K, const double *F, const double *q0, double tol,
-                           int max_iter, double *q, double *residual, int *iterations, double *work, int *iwork);
+RR_API int rr_static_solve(const rr_contact *c, double omega, const double *K, const double *F, const double *q0,
+                           double tol, int max_iter, double *q, double *residual, int *iterations, double *work,
+                           int *iwork);
 
 /* The central-difference matrices at spin speed omega, angular acceleration omega_dot and step dt,
  * assembled in the library's order of operations: C = D + omega G1,

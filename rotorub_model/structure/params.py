@@ -143,6 +143,11 @@ class ContactParams:
     theta_deg: float = _f(0, 60, doc="inclination of the conical casing inner surface [deg]")
     chord: float = _f(0, lo_open=True, doc="blade tip chord length l_c [m]")
     g0: float = _f(-INF, doc="nominal tip clearance [m] (negative = initial interference)")
+    slip_velocity: float = _f(0, 10.0, lo_open=True, default=0.1,
+                              doc="velocity scale of the friction regularisation mu tanh(v / v_slip) [m/s] "
+                                  "(default 0.1 m/s: far below the tip speeds of the paper's range (30 m/s at "
+                                  "Omega_ref), where friction is the exact Coulomb law, and large enough that the "
+                                  "explicit scheme stays stable, docs/THEORY.md)")
     max_penetration: float = _f(0, 0.05, lo_open=True, default=3.0e-3,
                                 doc="penetration beyond which a transient is declared diverged [m] (default 3 mm: "
                                     "the depth of a fan-case abradable liner; deeper, the blade cuts the case "

@@ -70,10 +70,10 @@ def compute() -> dict[str, np.ndarray]:
         c = make_contact(m, f, g0=g0)
         states = r.q[:: max(1, len(r.q) // 12)]
         data[f"laws_{f}_q"] = states
-        data[f"laws_{f}_force"] = np.array([c.forces(q) for q in states])
-        data[f"laws_{f}_jac"] = np.array([c.jacobian(q) for q in states])
+        data[f"laws_{f}_force"] = np.array([c.forces(q, speed * w_ref) for q in states])
+        data[f"laws_{f}_jac"] = np.array([c.jacobian(q, speed * w_ref) for q in states])
         data[f"laws_{f}_laws"] = np.array([c.laws(q) for q in states])
-        outs = [c.outputs(q) for q in states]
+        outs = [c.outputs(q, speed * w_ref) for q in states]
         data[f"laws_{f}_casing_force"] = np.array([o["casing_force"] for o in outs])
         data[f"laws_{f}_friction_torque"] = np.array([o["friction_torque"] for o in outs])
     r = run_transient(m, make_contact(m, "3D", g0=g0), speed * w_ref, t_end=2.5, record_dt=5e-3, hold=1e-3)
