@@ -48,3 +48,14 @@ def write_json(path: str | Path, data: dict[str, Any]) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(plain(data), indent=2) + "\n")
     return path
+
+
+def save_result(result: Any, out: str | Path, stem: str, summary_name: str | None = None) -> dict:
+    """The common ``save`` of a result object: ``out/<stem>.png`` from its ``plot`` and its
+    ``summary()`` as ``out/<summary_name or stem>.json``; returns the summary."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    result.plot(out / f"{stem}.png")
+    s = result.summary()
+    write_json(out / f"{summary_name or stem}.json", s)
+    return s

@@ -19,7 +19,7 @@ pytest.importorskip("pythonfmu", reason="building the FMU needs pythonfmu (pip i
 from fmu_src.fmi_run import FMUError, Slave, simulate  # noqa: E402
 from rotorub_model.analyses.stability import stability_of  # noqa: E402
 from rotorub_model.analyses.static import solve_static  # noqa: E402
-from rotorub_model.analyses.transient import run_transient  # noqa: E402
+from rotorub_model.analyses.transient import critical_time_step, run_transient  # noqa: E402
 from rotorub_model.contact import make_contact  # noqa: E402
 
 NB = 10
@@ -157,8 +157,13 @@ def test_substeps_follow_the_communication_step(fmu, unzipped, ref_model):
         assert np.array_equal(ra, rb)
         b.step(None, 0.37e-3)
         assert b.get("n_substeps") == 1 and b.get("dt_internal") == pytest.approx(0.37e-3)
+        # the rule: n = ceil(h / min(dt_max, half the stability limit at Omega rounded up to a whole rad/s))
+        cap = min(1e-3, 0.5 * critical_time_step(ref_model, make_contact(ref_model, "3D", g0=0.2e-3),
+                                                 float(math.ceil(omega))))
+        n = math.ceil(2.1e-3 / cap)
+        assert 2 < n < 10
         b.step(None, 2.1e-3)
-        assert b.get("n_substeps") == 5 and b.get("dt_internal") == pytest.approx(0.42e-3)
+        assert b.get("n_substeps") == n and b.get("dt_internal") == pytest.approx(2.1e-3 / n)
         assert b.get("status") == 0
 
 

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
-from ..results import pyplot, save_figure, write_json
+from ..results import pyplot, save_figure, save_result
 from ..structure.model import Model
 
 
@@ -93,12 +93,8 @@ class ResponseResult:
         return save_figure(fig, path)
 
     def save(self, out: str | Path) -> dict:
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        self.plot(out / "response.png")
-        np.savez(out / "response.npz", speeds=self.speeds, amplitude=self.amplitude, tilt=self.tilt)
-        s = self.summary()
-        write_json(out / "summary.json", s)
+        s = save_result(self, out, "response", "summary")
+        np.savez(Path(out) / "response.npz", speeds=self.speeds, amplitude=self.amplitude, tilt=self.tilt)
         return s
 
 
@@ -222,12 +218,7 @@ class ModesResult:
         return save_figure(fig, path)
 
     def save(self, out: str | Path) -> dict:
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        self.plot(out / "modes.png")
-        s = self.summary()
-        write_json(out / "modes.json", s)
-        return s
+        return save_result(self, out, "modes")
 
 
 def run_modes(model: Model, speed: float, K_extra: np.ndarray | None = None) -> ModesResult:
@@ -289,12 +280,7 @@ class CampbellResult:
         return save_figure(fig, path)
 
     def save(self, out: str | Path) -> dict:
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        self.plot(out / "campbell.png")
-        s = self.summary()
-        write_json(out / "campbell.json", s)
-        return s
+        return save_result(self, out, "campbell")
 
 
 def run_campbell(model: Model, speed_max: float = 10.0, n_speeds: int = 60) -> CampbellResult:

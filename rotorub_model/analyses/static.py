@@ -92,8 +92,9 @@ def solve_static(
     # Newton, its starts and the imbalance continuation run in the kernel (one call): the FMUs'
     # quasi-static steps are the same code
     ok = bool(contact.lib.rr_static_solve(
-        contact.kernel, float(omega), kernel.ptr(K), kernel.ptr(F), None if start is None else kernel.ptr(start), float(tol),
-        int(max_iter), kernel.ptr(q), ctypes.byref(rel), ctypes.byref(its), kernel.ptr(work), kernel.iptr(iwork)))
+        contact.kernel, float(omega), kernel.ptr(K), kernel.ptr(F), None if start is None else kernel.ptr(start),
+        float(tol), int(max_iter), kernel.ptr(q), ctypes.byref(rel), ctypes.byref(its), kernel.ptr(work),
+        kernel.iptr(iwork)))
     rel, its = rel.value, its.value
     if not ok and raise_on_failure:
         raise ConvergenceError(

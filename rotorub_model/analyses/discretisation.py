@@ -1,0 +1,145 @@
+"""What the blades' Ritz discretisation costs: frequencies against the number of functions.
+
+Two views, both on the blade alone (clamped on a fixed disk, the blade block of the model's
+matrices, so exactly what the model computes):
+
+* the uniform rotating cantilever of the literature (hub radius 0), in units of
+  sqrt(EI / (rho A l^4)): first flapwise mode (bending out of the rotation plane, stagger 90 deg)
+  and first lagwise mode (in the plane, stagger 0: spin softening lowers lambda^2 by mu^2),
+  for mu = Omega / sqrt(EI / (rho A l^4)) = 0..10;
+* the configuration's own blade (its hub radius and stagger) over the model's speed range: the
+  first bending frequency with n functions against the converged value.
+
+``run_blade_convergence`` returns a result that tabulates, plots and saves itself.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..results import pyplot, save_figure, save_result
+from ..structure.blades import bladed_disk_matrices
+from ..structure.params import Parameters
+
+N_CONVERGED = 8  # functions of the converged reference (flap and lag agree with 10 to 1e-5)
+
+
+def blade_unit(p: Parameters) -> float:
+    """sqrt(E I / (rho A l^4)) of the blade [rad/s]."""
+    b = p.blades
+    return float(np.sqrt(b.E * b.second_moment / (b.rho * b.area * b.length**4)))
+
+
+def blade_block(p: Parameters) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(K, M, S2 + N2) of blade 1 with the disk held fixed."""
+    mats = bladed_disk_matrices(p)
+    ns = 2 * p.shaft.n_ritz
+    sl = slice(ns, ns + p.blades.n_ritz)
+    return mats.K[sl, sl], mats.M[sl, sl], (mats.S2 + mats.N2)[sl, sl]
+
+
+def first_frequency(p: Parameters, omega: float) -> float:
+    """First bending frequency of a blade of ``p`` at spin speed omega [rad/s] (rotating frame)."""
+    K, M, KS = blade_block(p)
+    lam = np.linalg.eigvals(np.linalg.solve(M, K + omega * omega * KS)).real
+    return float(np.sqrt(lam.min()))
+
+
+def rotating_cantilever(p: Parameters, n_ritz: int, stagger_deg: float, mus: np.ndarray) -> np.ndarray:
+    """First frequency of the uniform rotating cantilever (hub radius 0) with n_ritz functions,
+    nondimensional, at nondimensional speeds mus; stagger 90: flapwise, 0: lagwise."""
+    q = p.replace(blades={"stagger_deg": stagger_deg, "hub_radius": 1e-9, "n_ritz": n_ritz})
+    u = blade_unit(q)
+    K, M, KS = blade_block(q)
+    out = []
+    for mu in mus:
+        lam = np.linalg.eigvals(np.linalg.solve(M, K + (mu * u) ** 2 * KS)).real
+        out.append(np.sqrt(lam.min()) / u)
+    return np.array(out)
+
+
+@dataclass
+class BladeConvergence:
+    n_values: list[int]
+    mus: np.ndarray  # nondimensional speeds of the cantilever table
+    flap: dict[int, np.ndarray]  # n -> first flapwise lambda at each mu
+    lag: dict[int, np.ndarray]  # n -> first lagwise lambda at each mu
+    speeds: np.ndarray  # [rad/s] the configuration's speed range
+    blade_hz: dict[int, np.ndarray]  # n -> first bending frequency of the configuration's blade [Hz]
+    n_model: int  # the configuration's n_ritz
+
+    def error(self, kind: str, n: int) -> np.ndarray:
+        """Relative error of n functions against the converged reference."""
+        d = {"flap": self.flap, "lag": self.lag, "blade": self.blade_hz}[kind]
+        return d[n] / d[N_CONVERGED] - 1.0
+
+    def summary(self) -> dict:
+        cost = self.error("blade", self.n_model)
+        k = int(np.argmax(np.abs(cost)))
+        return {
+            "n_ritz_of_the_model": self.n_model,
+            "cantilever_mu": self.mus,
+            "flap_max_error": {n: float(np.abs(self.error("flap", n)).max()) for n in self.n_values},
+            "lag_max_error": {n: float(np.abs(self.error("lag", n)).max()) for n in self.n_values},
+            "model_blade_max_error": float(cost[k]),
+            "model_blade_max_error_at_rad_s": float(self.speeds[k]),
+            "model_blade_error_at_rest": float(cost[0]),
+            "model_blade_hz_converged_at_rest_and_top": [float(self.blade_hz[N_CONVERGED][0]),
+                                                         float(self.blade_hz[N_CONVERGED][-1])],
+        }
+
+    def table_markdown(self, mus: tuple[float, ...] = (0.0, 5.0, 10.0)) -> str:
+        """Flap and lag errors against n at a few speeds (the theory notes' table)."""
+        idx = [int(np.argmin(np.abs(self.mus - m))) for m in mus]
+        head = "| n_ritz | " + " | ".join(f"flap mu={self.mus[i]:g}" for i in idx) + " | " + \
+               " | ".join(f"lag mu={self.mus[i]:g}" for i in idx) + " | reference blade, worst over 0-speed_max |"
+        rows = [head, "|" + "---|" * (2 + 2 * len(idx))]
+        for n in self.n_values:
+            f, g = self.error("flap", n), self.error("lag", n)
+            cells = [f"{100 * f[i]:+.3f} %" for i in idx] + [f"{100 * g[i]:+.3f} %" for i in idx]
+            cells.append(f"{100 * np.abs(self.error('blade', n)).max():.3f} %")
+            rows.append(f"| {n} | " + " | ".join(cells) + " |")
+        return "\n".join(rows)
+
+    def plot(self, path: str | Path) -> Path:
+        plt = pyplot()
+        fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+        for n in self.n_values:
+            if n == N_CONVERGED:
+                continue
+            axes[0].semilogy(self.mus, np.abs(self.error("flap", n)) * 100 + 1e-6, "-", label=f"flap, n={n}")
+            axes[0].semilogy(self.mus, np.abs(self.error("lag", n)) * 100 + 1e-6, "--", label=f"lag, n={n}")
+            axes[1].semilogy(self.speeds, np.abs(self.error("blade", n)) * 100 + 1e-6, label=f"n={n}")
+        axes[0].set_xlabel("mu = Omega / sqrt(EI / rho A l^4)")
+        axes[0].set_ylabel("error of the first frequency [%]")
+        axes[0].set_title("uniform rotating cantilever (hub radius 0)")
+        axes[1].set_xlabel("spin speed [rad/s]")
+        axes[1].set_title(f"the configuration's blade (model: n={self.n_model})")
+        for ax in axes:
+            ax.grid(alpha=0.3, which="both")
+            ax.legend(fontsize=7)
+        return save_figure(fig, path)
+
+    def save(self, out: str | Path) -> dict:
+        s = save_result(self, out, "blade_convergence")
+        (Path(out) / "blade_convergence.md").write_text(self.table_markdown() + "\n")
+        return s
+
+
+def run_blade_convergence(p: Parameters, n_values: tuple[int, ...] = (2, 3, 4, 5, 6, N_CONVERGED),
+                          n_speeds: int = 25) -> BladeConvergence:
+    """Flap and lag frequencies of the rotating cantilever (mu = 0..10) and of the configuration's
+    blade over 0..speed_max omega_ref, for each number of Ritz functions."""
+    ns = sorted(set(n_values) | {N_CONVERGED, p.blades.n_ritz})
+    mus = np.arange(11.0)
+    flap = {n: rotating_cantilever(p, n, 90.0, mus) for n in ns}
+    lag = {n: rotating_cantilever(p, n, 0.0, mus) for n in ns}
+    speeds = np.linspace(0.0, p.normalisation.speed_max * p.normalisation.omega_ref, n_speeds)
+    blade = {}
+    for n in ns:
+        q = p.replace(blades={"n_ritz": n})
+        blade[n] = np.array([first_frequency(q, w) for w in speeds]) / (2 * np.pi)
+    return BladeConvergence(ns, mus, flap, lag, speeds, blade, p.blades.n_ritz)

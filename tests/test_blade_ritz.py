@@ -1,0 +1,99 @@
+"""The blades' Ritz discretisation against the rotating-cantilever literature (issue 12, item 3).
+
+Reference computed here: a uniform Euler–Bernoulli cantilever (hub radius 0) of 32 Hermite
+elements, tension T(s) = rho A Omega^2 (l^2 - s^2) / 2 from the centrifugal field, flapwise
+(K + Kg) and lagwise (K + Kg - Omega^2 M: spin softening), matrices by Gauss quadrature. It
+matches the literature's first flapwise frequencies (Wright et al. 1982; Hodges & Rutkowski 1981)
+to their 4 decimals for mu = 0..10; the model's blade block (clamped-free polynomials) is held to it.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+
+import numpy as np
+import pytest
+from numpy.polynomial import legendre
+from scipy.linalg import eigh
+
+from rotorub_model.analyses.discretisation import rotating_cantilever, run_blade_convergence
+from rotorub_model.structure.params import reference_parameters
+
+# first flapwise lambda = omega / sqrt(EI / (rho A l^4)) of the uniform rotating cantilever, hub radius 0
+LITERATURE_FLAP = [3.5160, 3.6817, 4.1373, 4.7973, 5.5850, 6.4495, 7.3604, 8.2996, 9.2568, 10.2257, 11.2023]
+MUS = np.arange(11.0)
+
+
+@cache
+def fe_cantilever(n_elements: int = 32) -> tuple[np.ndarray, np.ndarray]:
+    """(flap, lag) first lambda at MUS from the reference FE (l = EI = rho A = 1)."""
+    xg, wg = legendre.leggauss(6)
+    x = 0.5 * (xg + 1.0)
+    h = 1.0 / n_elements
+    nd = 2 * (n_elements + 1)
+    K, M, Kg = np.zeros((nd, nd)), np.zeros((nd, nd)), np.zeros((nd, nd))
+    for e in range(n_elements):
+        z = (e + x) * h
+        w = 0.5 * wg * h
+        N = np.stack([1 - 3 * x**2 + 2 * x**3, h * (x - 2 * x**2 + x**3), 3 * x**2 - 2 * x**3, h * (x**3 - x**2)], -1)
+        dN = np.stack([(-6 * x + 6 * x**2) / h, 1 - 4 * x + 3 * x**2, (6 * x - 6 * x**2) / h, 3 * x**2 - 2 * x], -1)
+        ddN = np.stack([(-6 + 12 * x) / h**2, (-4 + 6 * x) / h, (6 - 12 * x) / h**2, (-2 + 6 * x) / h], -1)
+        blk = slice(2 * e, 2 * e + 4)
+        K[blk, blk] += (ddN.T * w) @ ddN
+        M[blk, blk] += (N.T * w) @ N
+        Kg[blk, blk] += (dN.T * (w * 0.5 * (1.0 - z**2))) @ dN
+    free = slice(2, nd)  # clamped root: u = u' = 0
+    K, M, Kg = K[free, free], M[free, free], Kg[free, free]
+    flap = [np.sqrt(eigh(K + mu**2 * Kg, M, eigvals_only=True, subset_by_index=[0, 0])[0]) for mu in MUS]
+    lag = [np.sqrt(eigh(K + mu**2 * (Kg - M), M, eigvals_only=True, subset_by_index=[0, 0])[0]) for mu in MUS]
+    return np.array(flap), np.array(lag)
+
+
+def test_reference_matches_the_literature_and_is_converged():
+    flap, lag = fe_cantilever()
+    np.testing.assert_allclose(flap, LITERATURE_FLAP, rtol=0, atol=0.6e-4)  # the table's last digit
+    np.testing.assert_allclose(lag**2, flap**2 - MUS**2, rtol=1e-7)  # uniform beam: softening by exactly mu^2
+    # converged: 24 elements agree to 1e-6 (flap) and 1e-5 (lag, whose lambda^2 = flap^2 - mu^2 magnifies
+    # relative errors 5x at mu = 10), a hundredth of the tolerances below; more elements only add
+    # round-off (the spectrum's top grows as h^-4)
+    f2, l2 = fe_cantilever(24)
+    assert np.abs(f2 / flap - 1).max() < 1e-6 and np.abs(l2 / lag - 1).max() < 1e-5
+
+
+@pytest.mark.parametrize("n", [5, 6])
+def test_flap_and_lag_within_a_tenth_of_a_percent(n):
+    """n >= 5: first flap and lag frequencies within 0.1 % for mu = 0..10 (measured: 0.035 % at n = 5)."""
+    flap, lag = fe_cantilever()
+    p = reference_parameters()
+    assert np.abs(rotating_cantilever(p, n, 90.0, MUS) / flap - 1).max() < 1e-3
+    assert np.abs(rotating_cantilever(p, n, 0.0, MUS) / lag - 1).max() < 1e-3
+
+
+def test_four_functions():
+    """n = 4: flap within 0.1 % up to mu = 10; lag within 0.1 % up to mu = 7 and 0.37 % at mu = 10
+    (the lag mode's root boundary layer at high spin is what four polynomials miss; the issue asked
+    0.1 % from n = 4: not met for the lag mode above mu = 7, docs/THEORY.md)."""
+    flap, lag = fe_cantilever()
+    p = reference_parameters()
+    ef = rotating_cantilever(p, 4, 90.0, MUS) / flap - 1
+    el = rotating_cantilever(p, 4, 0.0, MUS) / lag - 1
+    assert np.abs(ef).max() < 1e-3
+    assert np.abs(el[MUS <= 7]).max() < 1e-3
+    assert np.abs(el).max() < 4e-3
+    assert np.all(ef >= -1e-6) and np.all(el >= -1e-6)  # Rayleigh–Ritz: from above
+
+
+def test_errors_fall_with_every_function_and_the_papers_two_cost_what_the_report_says():
+    """The convergence table of the theory notes: each added function lowers the worst error; the
+    paper's two functions are 2.4 % high (flap) and 11.4 % high (lag) at mu = 10, and the reference
+    blade's first frequency 3.7 % high at the top of the speed range."""
+    r = run_blade_convergence(reference_parameters())
+    flap, lag = fe_cantilever()
+    for kind, ref in (("flap", flap), ("lag", lag)):
+        worst = [np.abs(getattr(r, kind)[n] / ref - 1).max() for n in (2, 3, 4, 5, 6)]
+        assert all(b < a for a, b in zip(worst, worst[1:])), (kind, worst)
+    assert r.flap[2][-1] / flap[-1] - 1 == pytest.approx(0.0241, abs=5e-4)
+    assert r.lag[2][-1] / lag[-1] - 1 == pytest.approx(0.1135, abs=5e-4)
+    s = r.summary()
+    assert s["model_blade_max_error"] == pytest.approx(0.037, abs=1e-3)
+    assert s["model_blade_error_at_rest"] == pytest.approx(0.0048, abs=2e-4)
