@@ -88,6 +88,33 @@ def test_transient_through_fmpy_equals_library_to_1e_9(fmu, ref_model):
     assert np.abs(r["casing_force.x"][1:] - Fc[:, 0]).max() <= 1e-9 * np.abs(Fc).max()
 
 
+def test_run_down_to_rest_friction_follows_the_sliding(fmu, ref_model):
+    """A run-down from 3.3 omega_ref to rest with an interference fit (g0 = -0.1 mm): once the spin
+    stops, the ringing blades slide both ways over the casing and the friction force follows
+    (F_T takes both signs, never above mu F_N); the FMU equals the library to 1e-9 all along."""
+    p = ref_model.params
+    w0, g0, me, t_end = 3.3 * p.normalisation.omega_ref, -0.1e-3, p.imbalance.me, 1.5
+    sig = np.array([(0.0, w0, 0.0), (0.3, w0, me), (0.5, w0, me), (0.8, 0.0, me), (t_end + 1.0, 0.0, me)],
+                   dtype=[("time", float), ("Omega", float), ("imbalance", float)])
+    FT = [f"blade[{j}].F_T" for j in range(1, NB + 1)]
+    r = simulate(fmu, stop_time=t_end, output_interval=1e-3, input=sig, start_values={"g0": g0, "formulation": "3D"},
+                 output=FN + FT + ["status"])
+    lib = run_transient(ref_model, make_contact(ref_model, "3D", g0=g0),
+                        lambda t: w0 * min(max((0.8 - t) / 0.3, 0.0), 1.0), t_end=t_end, t_ramp=0.3, me=me,
+                        record_dt=1e-3, hold=1e-3)
+    assert not lib.diverged and np.all(r["status"] == 0)
+    F_N, F_T = np.array([r[n] for n in FN]).T[1:], np.array([r[n] for n in FT]).T[1:]
+    assert np.abs(F_N - lib.outputs["F_N"]).max() <= 1e-9 * np.abs(lib.outputs["F_N"]).max()
+    assert np.abs(F_T - lib.outputs["F_T"]).max() <= 1e-9 * np.abs(lib.outputs["F_T"]).max()
+    mu = p.contact.mu
+    assert np.all(np.abs(F_T) <= mu * F_N * (1 + 1e-12) + 1e-12)
+    spinning, at_rest = lib.t < 0.5, lib.t > 0.85
+    # tip speed >> slip_velocity: Coulomb against the spin (summed over LE and TE: equal to rounding)
+    np.testing.assert_allclose(F_T[spinning], mu * F_N[spinning], rtol=1e-12, atol=1e-12 * F_N.max())
+    assert F_N[at_rest].max() > 50.0
+    assert F_T[at_rest].min() < -0.5 and F_T[at_rest].max() > 0.5  # both ways once the spin has stopped
+
+
 def test_quasi_static_mode_equals_static_solver(fmu, ref_model):
     """A speed sweep through contact: each step the balanced solution, warm-started from the last."""
     p = ref_model.params
