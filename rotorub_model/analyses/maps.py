@@ -160,6 +160,13 @@ class StabilityMap:
         axes[1].set_title(f"{self.formulation}: stability (green = stable, grey = no equilibrium)")
         return save_figure(fig, path)
 
+    @classmethod
+    def load(cls, folder: str | Path, formulation: str) -> StabilityMap:
+        """A map written by :meth:`save` (``stability_<formulation>.npz`` in ``folder``)."""
+        d = np.load(Path(folder) / f"stability_{formulation}.npz")
+        return cls(formulation, d["speeds"], d["g0s"], d["n_contact"].astype(int), d["chord_total"], d["max_real"],
+                   d["sum_pos"], d["converged"])
+
     def save(self, out: str | Path) -> dict:
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)

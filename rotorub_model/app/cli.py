@@ -184,6 +184,18 @@ def cmd_detect(ns: argparse.Namespace) -> dict:
     return {**{k: s[k] for k in keep}, "written": str(Path(ns.out) / "summary.json")}
 
 
+@command("continuation", "static branches with their Hopf, fold and switch points, the periodic orbits past "
+         "them, and the stability boundary as curves over the (speed, g0) maps")
+@arg("--speed", type=float, default=3.3, help="normalised speed of the g0 branches and orbits (default 3.3)")
+@arg("--maps", default=None, help="a stability study's folder (rotorub stability --out DIR) to draw the curves over "
+     "and check them against; default: the quick maps are computed")
+@arg("--quick", action="store_true", help="fewer periodic orbits per branch")
+def cmd_continuation(ns: argparse.Namespace) -> dict:
+    from .studies import run_continuation_study
+
+    return run_continuation_study(_model(ns), ns.out, speed=ns.speed, maps_dir=ns.maps, quick=ns.quick)
+
+
 @command("reproduce", "main job: every analysis of the paper on one configuration, with a summary")
 @arg("--quick", action="store_true", help="coarse grids: a few minutes on 2 cores")
 @arg("--no-fmu", action="store_true", help="library analyses only (no FMU build, harnesses or coupled run)")

@@ -14,6 +14,9 @@ FIGURES = [
     ("Detection vs chord length (paper Fig. 9)", "detection/detection_chord.png"),
     ("Static solutions and their stability, 2D and 3D (paper Fig. 10-11)", "stability/stability_maps.png"),
     ("Normal contact forces per blade, 2D vs 3D transient (paper Fig. 12)", "transient/contact_forces.png"),
+    ("Continuation: static branches, special points and periodic orbits at the section-6 speed",
+     "continuation/continuation.png"),
+    ("Stability boundary by continuation over the grid maps", "continuation/boundaries.png"),
     ("Blades' Ritz discretisation: frequency error against the number of functions",
      "discretisation/blade_convergence.png"),
 ]
@@ -70,6 +73,27 @@ def _fmu_section(summary: dict) -> list[str]:
     return lines
 
 
+def _continuation_section(c: dict) -> list[str]:
+    lines = ["", "## Continuation: special points, what the instability grows into, the boundary as a curve", "",
+             "Static branches in g0 at the section-6 speed (pseudo-arclength through contact events), their Hopf, "
+             "fold and contact-induced switch points, the periodic orbits past them (shooting with the transient "
+             "kernel, Floquet multipliers), and the stability boundary traced as curves over the grid maps "
+             "(`rotorub continuation`; `continuation/continuation.png`, `continuation/boundaries.png`).", "",
+             "| formulation | special points (kind @ g0 mm: Re, Im of the critical eigenvalue) | orbits | boundary "
+             "curves (points) | grid cells contradicting the curves (beyond one cell) |",
+             "|---|---|---|---|---|"]
+    for f in ("2D", "3D"):
+        if f not in c:
+            continue
+        sp = "; ".join(f"{s['kind']} @ {s['g0_m'] * 1e3:.6g}: {_fmt(s.get('critical_eigenvalue', ''))}"
+                       for s in c[f]["specials"]) or "none"
+        b = c[f]["boundary"]
+        lines.append(f"| {f} | {sp} | {c[f]['orbits']} | {b.get('curves')} ({b.get('points')}) | "
+                     f"{b.get('contradicting_cells', '?')} ({b.get('contradicting_beyond_one_cell', '?')}, "
+                     f"{100 * b.get('contradicting_beyond_one_cell_fraction', float('nan')):.1f} %) |")
+    return lines
+
+
 def _discretisation_section(d: dict) -> list[str]:
     n = d["n_ritz_of_the_model"]
     lo, hi = d["model_blade_hz_converged_at_rest_and_top"]
@@ -113,6 +137,8 @@ def write_report(out: str | Path, summary: dict) -> Path:
         lines.append("Every fact holds on this configuration.")
     for f in failing:
         lines.append(f"* Fact {f['id']}: {f.get('why', 'see the values in the table and docs/THEORY.md')}")
+    if "continuation" in summary:
+        lines += _continuation_section(summary["continuation"])
     if "blade_discretisation" in summary:
         lines += _discretisation_section(summary["blade_discretisation"])
     if "harnesses" in summary:

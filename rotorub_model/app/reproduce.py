@@ -92,6 +92,9 @@ def run_reproduce(model: Model, out: str | Path, quick: bool = False) -> dict:
     disc_summary["table_markdown"] = disc.table_markdown()
     stab = run_stability_study(model, out / "stability", quick=quick)
     tr = run_transient_study(model, out / "transient", stab_dir=out / "stability")
+    from .studies import run_continuation_study
+
+    cont = run_continuation_study(model, out / "continuation", maps_dir=out / "stability", quick=quick)
     summary = {
         "n_dofs": model.n_dofs,
         "omega_ref_rad_s": model.params.normalisation.omega_ref,
@@ -100,6 +103,7 @@ def run_reproduce(model: Model, out: str | Path, quick: bool = False) -> dict:
         "stability": {k: v for k, v in stab.items() if not k.startswith("map_")},
         "transient": tr,
         "blade_discretisation": disc_summary,
+        "continuation": cont,
         "paper_facts": [fact1(resp), *detection_facts(det), fact5(stab), *fact6(tr)],
     }
     write_json(out / "summary.json", summary)

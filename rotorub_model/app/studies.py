@@ -299,3 +299,24 @@ def run_transient_study(model: Model, out: str | Path, speed: float | None = Non
     runs = {f: run_transient(model, make_contact(model, f, g0=g0), omega, t_end=t_end, progress=progress)
             for f in ("2D", "3D")}
     return TransientStudy(speed, g0, runs, statics).save(out)
+
+
+def run_continuation_study(model: Model, out: str | Path, speed: float = 3.3, maps_dir: str | Path | None = None,
+                           quick: bool = True, progress: bool = True) -> dict:
+    """Branches, special points, orbits and boundary curves (``analyses.continuation``) against the
+    stability maps of ``maps_dir`` (or the quick maps, computed here)."""
+    from ..analyses.continuation import run_continuation
+
+    if maps_dir is not None:
+        try:
+            maps = {f: StabilityMap.load(maps_dir, f) for f in ("2D", "3D")}
+        except FileNotFoundError as exc:
+            raise ParameterError(f"maps: {exc.filename} not found; run `rotorub stability --out DIR` first") from None
+    else:
+        speeds, g0s = default_grid(model, quick=True)
+        maps = {f: run_stability_map(model, f, speeds, g0s, progress=progress) for f in ("2D", "3D")}
+    r = run_continuation(model, maps=maps, speed=speed, quick=quick, progress=progress)
+    s = r.save(out)
+    return {f: {"specials": s[f]["specials"], "boundary": s[f]["boundary"],
+                "orbits": [len(b["orbits"]) for b in s[f]["orbit_branches"]]} for f in ("2D", "3D")} | \
+        {"written": str(Path(out) / "summary.json")}

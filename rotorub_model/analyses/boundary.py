@@ -1,0 +1,390 @@
+"""The stability boundary of the balanced solutions in the (Omega, g0) plane, traced as curves.
+
+A point of the boundary separates a stable balanced solution from an unstable one. Two kinds
+occur, and one tracker follows both:
+
+* **Hopf curves**: the critical eigenvalue's real part crosses zero within one contact set
+  (located by regula falsi on Re mu to |Re mu| <= 1e-8 /s);
+* **switch curves**: the stability changes where a contact point's gap crosses zero (2D: a blade
+  entering contact makes the point law's stiffness jump, and the eigenvalues with it), located
+  on the gap.
+
+Two-parameter continuation by bracketing: in coordinates scaled by the map's cell size, a curve
+point P with unit normal n (pointing to the unstable side) and tangent tau is continued by the
+predictor C = P + h tau; the corrector brackets the boundary on the normal line through C (a
+stable point C - d n, an unstable one C + d n) and locates the crossing there. Step h: at most
+``resolution`` cells (a tenth of a cell by default), halved where the bracket fails (a corner,
+where a Hopf curve meets a switch curve). Balanced solutions are warm-started from the nearest
+curve point, so the tracker stays on the branch the maps follow (descending g0).
+
+Seeds: the verdicts on a coarse lattice (each speed swept from the largest clearance down, as
+the grid maps are); every lattice edge whose ends disagree and that no traced curve crosses yet
+starts a curve, traced both ways until it leaves the range, closes, or stops.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .equilibria import Equilibria
+from .stability import RE_TOL
+
+
+@dataclass
+class Sample:
+    omega: float
+    g0: float
+    q: np.ndarray
+    contact_set: tuple
+    mu: complex  # critical eigenvalue (Im > 0), refined
+    max_real: float
+
+    @property
+    def unstable(self) -> bool:
+        return self.max_real > RE_TOL
+
+
+@dataclass
+class Curve:
+    speeds: list[float] = field(default_factory=list)  # normalised Omega / Omega_ref
+    g0s: list[float] = field(default_factory=list)  # [m]
+    kinds: list[str] = field(default_factory=list)  # "hopf" or "switch" per point
+    frequencies: list[float] = field(default_factory=list)  # [rad/s] critical |Im mu| on the unstable side
+    normals: list[tuple[float, float]] = field(default_factory=list)  # scaled coordinates, towards unstable
+    closed: bool = False
+
+    def __len__(self) -> int:
+        return len(self.speeds)
+
+
+class BoundaryTracer:
+    def __init__(self, eq: Equilibria, speeds: tuple[float, float], g0s: tuple[float, float], cell: tuple[float, float],
+                 resolution: float = 0.1):
+        self.eq = eq
+        self.wref = eq.model.params.normalisation.omega_ref
+        self.s_lo, self.s_hi = speeds
+        self.g_lo, self.g_hi = g0s
+        self.cs, self.cg = cell  # cell size in speed (normalised) and in g0 [m]
+        self.h_max = resolution
+        self.evaluations = 0
+        self.full_spectra = 0
+        self.tracking = False  # while tracing, a solution far from its warm start is another branch: refused
+        self.guard = False
+        # the 3D chord law is C^1: the spectrum is continuous across contact events and the critical
+        # eigenvalue can be followed through them; the 2D point law's stiffness jumps there
+        self.continuous = eq.formulation == "3D"
+
+    # ------------------------------------------------------------------ coordinates
+    def to_xy(self, speed: float, g0: float) -> np.ndarray:
+        return np.array([speed / self.cs, g0 / self.cg])
+
+    def from_xy(self, p: np.ndarray) -> tuple[float, float]:
+        return float(p[0] * self.cs), float(p[1] * self.cg)
+
+    def inside(self, p: np.ndarray) -> bool:
+        s, g = self.from_xy(p)
+        return self.s_lo - 1e-12 <= s <= self.s_hi + 1e-12 and self.g_lo - 1e-15 <= g <= self.g_hi + 1e-15
+
+    # ------------------------------------------------------------------ evaluations
+    def _solve(self, w: float, g: float, q0: np.ndarray | None) -> np.ndarray | None:
+        """The balanced solution continued from q0; None where it is lost (a fold: the solver's other
+        starts would land on another branch, which the maps do not follow either)."""
+        q = self.eq.solve(w, g, q0)
+        self.evaluations += 1
+        if q is None or (self.tracking and self.guard and q0 is not None and
+                         np.linalg.norm(q - q0) > 0.25 * np.linalg.norm(q0) + 1e-7):
+            return None
+        return q
+
+    def sample(self, p: np.ndarray, q0: np.ndarray | None, previous: Sample | None = None) -> Sample | None:
+        """The balanced solution at p and its stability. With ``previous`` (in the same contact set,
+        or any in 3D) the critical eigenvalue is followed by Newton from it (no full spectrum)."""
+        s, g = self.from_xy(p)
+        w = s * self.wref
+        q = self._solve(w, g, q0)
+        if q is None:
+            return None
+        cset = self.eq.contact_set(q, g)
+        if previous is not None and (cset == previous.contact_set or self.continuous):
+            mu, _ = self.eq.refine(q, w, g, previous.mu)
+            if abs(mu - previous.mu) < 0.05 * abs(previous.mu):
+                others = previous.max_real if previous.max_real > previous.mu.real + 1e-9 else -math.inf
+                return Sample(w, g, q, cset, mu, max(mu.real, others))
+        mu, mr = self.eq.critical(q, w, g)
+        self.full_spectra += 1
+        return Sample(w, g, q, cset, mu, mr)
+
+    def _jump(self, a: np.ndarray, b: np.ndarray, sa: Sample, n_sub: int = 6) -> float | None:
+        """Where the balanced solution continued from a towards b jumps to another branch (a fold of
+        the branch the maps follow), to 1e-6 of the segment; None if it is continuous."""
+        ts = np.linspace(0.0, 1.0, n_sub + 1)
+        qs = [sa.q]
+        for t in ts[1:]:
+            s_, g_ = self.from_xy(a + t * (b - a))
+            q = self.eq.solve(s_ * self.wref, g_, qs[-1])
+            self.evaluations += 1
+            if q is None:
+                return None
+            qs.append(q)
+        steps = np.array([np.linalg.norm(y - x) for x, y in zip(qs[:-1], qs[1:])])
+        k = int(np.argmax(steps))
+        rest = np.delete(steps, k)
+        if steps[k] <= 5.0 * max(float(np.median(rest)), 1e-3 * np.linalg.norm(sa.q) / n_sub):
+            return None
+        rate = float(np.median(rest)) / (ts[1] - ts[0])
+        lo, hi, q_lo = ts[k], ts[k + 1], qs[k]
+        while hi - lo > 1e-6:
+            mid = 0.5 * (lo + hi)
+            s_, g_ = self.from_xy(a + mid * (b - a))
+            q = self.eq.solve(s_ * self.wref, g_, q_lo)
+            self.evaluations += 1
+            if q is not None and np.linalg.norm(q - q_lo) <= 3.0 * rate * (mid - lo) + 1e-12:
+                lo, q_lo = mid, q
+            else:
+                hi = mid
+        return 0.5 * (lo + hi)
+
+    def locate(self, a: np.ndarray, b: np.ndarray, sa: Sample, sb: Sample, depth: int = 0):
+        """The boundary point between a (stable) and b (unstable): (position, kind, stable sample,
+        unstable sample)."""
+
+        def at(t: float, ref: Sample) -> Sample | None:
+            return self.sample(a + t * (b - a), ref.q, ref)
+
+        tj = self._jump(a, b, sa) if depth == 0 else None
+        if tj is not None:
+            # the followed branch ends (a fold): the verdict changes with the branch
+            return a + tj * (b - a), "fold", sa, sb
+
+        if sa.contact_set == sb.contact_set or self.continuous:
+            state = {"s": sb}
+
+            def re(t):
+                smp = at(t, state["s"])
+                if smp is None:
+                    return None
+                state["s"] = smp
+                return smp.mu.real
+
+            t = _regula_falsi(re, sa.mu.real, sb.mu.real, 1e-7, 1e-8)
+            if t is None:
+                return None
+            return a + t * (b - a), "hopf", sa, state["s"]
+        # a contact event in between: where the first differing point's gap crosses zero
+        k = next(i for i, (x, y) in enumerate(zip(sa.contact_set, sb.contact_set)) if x != y)
+
+        def gap(t):
+            s_, g_ = self.from_xy(a + t * (b - a))
+            q = self._solve(s_ * self.wref, g_, sa.q)  # the gap needs no spectrum
+            return None if q is None else float(self.eq.contact(g_).gaps(q).ravel()[k])
+
+        ga = float(self.eq.contact(sa.g0).gaps(sa.q).ravel()[k])
+        gb = float(self.eq.contact(sb.g0).gaps(sb.q).ravel()[k])
+        if ga * gb >= 0 or depth > 6:
+            return None
+        te = _regula_falsi(gap, ga, gb, 1e-9, 1e-8 * self.cg)
+        if te is None:
+            return None
+        eps = 1e-5  # either side of the event, well beyond its location error
+        # either side: the eigenvalue followed from the bracket's end with the same contact set (a
+        # full spectrum where the set differs from both)
+        left, right = at(max(te - eps, 0.0), sa), at(min(te + eps, 1.0), sb)
+        if left is None or right is None:
+            return None
+        if left.unstable != right.unstable:
+            return a + te * (b - a), "switch", left, right
+        pa, pb = a + max(te - eps, 0.0) * (b - a), a + min(te + eps, 1.0) * (b - a)
+        if left.unstable:  # the crossing is before the event
+            return self.locate(a, pa, sa, left, depth + 1)
+        return self.locate(pb, b, right, sb, depth + 1)
+
+    def trace(self, a: np.ndarray, b: np.ndarray, sa: Sample, sb: Sample, max_points: int = 4000) -> Curve | None:
+        """The curve through the boundary point between a (stable) and b (unstable), both ways."""
+        first = self.locate(a, b, sa, sb)  # across a lattice edge: no continuity guard yet
+        if first is None:
+            return None
+        self.tracking = True
+        try:
+            return self._trace(a, b, first, max_points)
+        finally:
+            self.tracking = False
+
+    def _trace(self, a, b, first, max_points):
+        p0, kind0, r0a, r0b = first
+        n0 = (b - a) / np.linalg.norm(b - a)
+        halves = []
+        for direction in (1.0, -1.0):
+            pts = [(p0, kind0, r0b, n0)]
+            p, n, ref = p0, n0, (r0a, r0b)
+            tau = direction * np.array([-n[1], n[0]])
+            h = self.h_max
+            closed = False
+            while len(pts) < max_points:
+                c = p + h * tau
+                if not self.inside(c):
+                    c = _clip_to_box(p, c, self)
+                    if c is None or np.linalg.norm(c - p) < 1e-6:
+                        break
+                got = self._bracket(c, n, ref, h)
+                if got is None:
+                    h *= 0.5
+                    if h < 1e-3 * self.h_max:
+                        break
+                    continue
+                pn, kind, ra, rb = got
+                if len(pts) % 10 == 0:  # every tenth point: whole spectra, so that no other mode is missed
+                    fa, fb = self.sample(ra_xy(self, ra), ra.q), self.sample(ra_xy(self, rb), rb.q)
+                    ra, rb = fa or ra, fb or rb
+                smp = rb
+                step = pn - p
+                if np.linalg.norm(step) < 1e-9:
+                    h *= 0.5
+                    continue
+                t_new = step / np.linalg.norm(step)
+                n_new = np.array([t_new[1], -t_new[0]]) * direction
+                if n_new @ n < 0:
+                    n_new = -n_new
+                pts.append((pn, kind, smp, n_new))
+                p, n, tau, ref = pn, n_new, t_new, (ra, rb)
+                if len(pts) > 20 and direction > 0 and np.linalg.norm(p - p0) < 0.5 * self.h_max:
+                    closed = True
+                    break
+                recent = np.array([x[0] for x in pts[-40:-3]])
+                if len(recent) and np.min(np.linalg.norm(recent - p, axis=1)) < 0.3 * self.h_max:
+                    break  # going round in circles (a fold of the balanced solutions): the curve ends here
+                if not self.inside(p + 1e-9 * tau) and np.linalg.norm(p - c) < 1e-9:
+                    break
+                h = min(h * 1.5, self.h_max)
+            halves.append((pts, closed))
+            if closed:
+                break
+        fwd, closed = halves[0]
+        back = halves[1][0][1:] if len(halves) > 1 else []
+        ordered = [*reversed(back), *fwd]
+        cv = Curve(closed=closed)
+        for p, kind, smp, n in ordered:
+            s, g = self.from_xy(p)
+            cv.speeds.append(s)
+            cv.g0s.append(g)
+            cv.kinds.append(kind)
+            cv.frequencies.append(abs(smp.mu.imag))
+            cv.normals.append((float(n[0]), float(n[1])))
+        return cv
+
+    def _bracket(self, c: np.ndarray, n: np.ndarray, ref: tuple[Sample, Sample], h: float):
+        for d in (0.5 * max(h, 0.05), 0.25, 0.6, 1.2):
+            a, b = c - d * n, c + d * n  # may reach a cell past the range: g0 < 0 is an interference fit
+            sa, sb = self.sample(a, ref[0].q, ref[0]), self.sample(b, ref[1].q, ref[1])
+            if sa is None or sb is None:
+                continue
+            if (not sa.unstable) and sb.unstable:
+                got = self.locate(a, b, sa, sb)
+                if got is not None:
+                    return got
+            if sa.unstable == sb.unstable:
+                continue
+            return None  # reversed: a sharp turn, the step is too long
+        return None
+
+
+def ra_xy(tr: BoundaryTracer, smp: Sample) -> np.ndarray:
+    return tr.to_xy(smp.omega / tr.wref, smp.g0)
+
+
+def _clip_to_box(p, c, tr: BoundaryTracer):
+    lo = tr.to_xy(tr.s_lo, tr.g_lo)
+    hi = tr.to_xy(tr.s_hi, tr.g_hi)
+    d = c - p
+    t = 1.0
+    for i in range(2):
+        if d[i] > 0 and c[i] > hi[i]:
+            t = min(t, (hi[i] - p[i]) / d[i])
+        if d[i] < 0 and c[i] < lo[i]:
+            t = min(t, (lo[i] - p[i]) / d[i])
+    return p + max(t, 0.0) * d
+
+
+def _regula_falsi(f, fa: float, fb: float, tol_t: float, f_tol: float, max_iter: int = 80):
+    a, b, side = 0.0, 1.0, 0
+    for _ in range(max_iter):
+        t = (a * fb - b * fa) / (fb - fa) if fb != fa else 0.5 * (a + b)
+        ft = f(t)
+        if ft is None:
+            return None
+        if abs(ft) <= f_tol or (b - a) <= tol_t:
+            return t
+        if (ft > 0) == (fb > 0):
+            b, fb = t, ft
+            if side == 1:
+                fa *= 0.5
+            side = 1
+        else:
+            a, fa = t, ft
+            if side == -1:
+                fb *= 0.5
+            side = -1
+    return t
+
+
+def crosses(curve: Curve, tr: BoundaryTracer, a: np.ndarray, b: np.ndarray) -> bool:
+    """Does the polyline of ``curve`` cross the segment a-b (scaled coordinates)?"""
+    P = np.array([tr.to_xy(s, g) for s, g in zip(curve.speeds, curve.g0s)])
+    for p, r in zip(P[:-1], P[1:]):
+        if _segments_intersect(a, b, p, r):
+            return True
+    return False
+
+
+def near(curve: Curve, tr: BoundaryTracer, a: np.ndarray, b: np.ndarray) -> bool:
+    """Does the curve pass within half a cell of the segment a-b's midpoint region (a seed it
+    already accounts for, where its polyline stopped short of the lattice edge)?"""
+    P = np.array([tr.to_xy(s, g) for s, g in zip(curve.speeds, curve.g0s)])
+    m = 0.5 * (a + b)
+    return bool(np.min(np.linalg.norm(P - m, axis=1)) < 0.5 * np.linalg.norm(b - a))
+
+
+def _segments_intersect(a, b, c, d) -> bool:
+    def orient(p, q, r):
+        return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
+
+    o1, o2, o3, o4 = orient(a, b, c), orient(a, b, d), orient(c, d, a), orient(c, d, b)
+    return (o1 * o2 <= 0) and (o3 * o4 <= 0)
+
+
+def trace_boundaries(eq: Equilibria, speeds: np.ndarray, g0s: np.ndarray, resolution: float = 0.1,
+                     lattice: tuple[int, int] = (9, 9)) -> tuple[list[Curve], dict]:
+    """Every stability-boundary curve inside the range of the map grid (normalised ``speeds`` x
+    ``g0s`` [m]), points at most ``resolution`` cells apart."""
+    cs = (speeds[-1] - speeds[0]) / max(len(speeds) - 1, 1)
+    cg = (g0s.max() - g0s.min()) / max(len(g0s) - 1, 1)
+    tr = BoundaryTracer(eq, (float(speeds[0]), float(speeds[-1])), (float(g0s.min()), float(g0s.max())), (cs, cg),
+                        resolution)
+    ls = np.linspace(speeds[0], speeds[-1], lattice[0])
+    lg = np.linspace(g0s.max(), g0s.min(), lattice[1])
+    grid: dict[tuple[int, int], Sample | None] = {}
+    for i, s in enumerate(ls):
+        q = None
+        for j, g in enumerate(lg):
+            smp = tr.sample(tr.to_xy(s, g), q)
+            grid[i, j] = smp
+            q = smp.q if smp is not None else None
+    curves: list[Curve] = []
+    edges = [((i, j), (i, j + 1)) for i in range(len(ls)) for j in range(len(lg) - 1)]
+    edges += [((i, j), (i + 1, j)) for i in range(len(ls) - 1) for j in range(len(lg))]
+    for e0, e1 in edges:
+        s0, s1 = grid[e0], grid[e1]
+        if s0 is None or s1 is None or s0.unstable == s1.unstable:
+            continue
+        a, b = tr.to_xy(ls[e0[0]], lg[e0[1]]), tr.to_xy(ls[e1[0]], lg[e1[1]])
+        if any(crosses(c, tr, a, b) or near(c, tr, a, b) for c in curves):
+            continue
+        if s0.unstable:
+            a, b, s0, s1 = b, a, s1, s0
+        cv = tr.trace(a, b, s0, s1)
+        if cv is not None and len(cv) > 1:
+            curves.append(cv)
+    return curves, {"evaluations": tr.evaluations, "cell": [cs, cg], "resolution_cells": resolution,
+                    "lattice": list(lattice)}

@@ -1,0 +1,154 @@
+"""Continuation (issue 13): special points located, the cycle born at a Hopf point, the orbit a
+transient settles on, and the boundary curves against the grid maps."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rotorub_model.analyses.boundary import trace_boundaries
+from rotorub_model.analyses.branch import continue_static
+from rotorub_model.analyses.continuation import agreement
+from rotorub_model.analyses.equilibria import Equilibria
+from rotorub_model.analyses.maps import run_stability_map
+from rotorub_model.analyses.periodic import continue_orbits, continue_orbits_from_hopf, orbit_from_state
+from rotorub_model.analyses.transient import run_transient
+from rotorub_model.structure.model import build_model
+
+
+@pytest.fixture(scope="module")
+def model():
+    return build_model()
+
+
+@pytest.fixture(scope="module")
+def w33(model):
+    return 3.3 * model.params.normalisation.omega_ref
+
+
+@pytest.fixture(scope="module")
+def hopf_3d(model, w33):
+    eq = Equilibria(model, "3D")
+    b = continue_static(eq, "g0", w33, 0.36e-3, 0.32e-3)
+    return eq, b
+
+
+def test_hopf_point_is_located_to_1e_8(hopf_3d, w33):
+    eq, b = hopf_3d
+    assert b.complete
+    hopf = b.of_kind("hopf")
+    assert len(hopf) == 1
+    h = hopf[0].point
+    assert abs(h.mu.real) <= 1e-8
+    # recomputed from scratch (full spectrum, then Newton): the same eigenvalue, on the axis
+    q = eq.solve(w33, h.g0, h.q)
+    mu, max_real = eq.critical(q, w33, h.g0)
+    assert abs(mu.real) <= 1e-8 and abs(mu - h.mu) <= 1e-8 * abs(mu)
+    # and it is a crossing: stable just above, unstable just below (g0 decreasing)
+    d = 1e-8
+    above = eq.critical(eq.solve(w33, h.g0 + d, q), w33, h.g0 + d)[0].real
+    below = eq.critical(eq.solve(w33, h.g0 - d, q), w33, h.g0 - d)[0].real
+    assert above < 0 < below
+    assert hopf[0].detail["direction"] == "destabilising"
+
+
+def test_cycle_born_at_the_hopf_point_has_its_frequency(hopf_3d, w33):
+    eq, b = hopf_3d
+    h = b.of_kind("hopf")[0].point
+    br = continue_orbits_from_hopf(eq, w33, h.g0, h.mu, 0.0, max_orbits=3)
+    first = br.orbits[0]
+    assert first.residual < 1e-8
+    assert first.disk_peak_to_peak < 1e-6  # a small cycle, near the Hopf point
+    assert first.frequency == pytest.approx(abs(h.mu.imag), rel=1e-3)
+    # supercritical: the cycles grow past the Hopf point (smaller g0; the scheme's own Hopf point sits
+    # 2e-5 relative higher, the central-difference frequency shift) and are stable there
+    g, amp = [o.g0 for o in br.orbits], [o.disk_peak_to_peak for o in br.orbits]
+    assert g[-1] < h.g0 and np.all(np.diff(g) < 0) and np.all(np.diff(amp) > 0)
+    assert abs(g[0] / h.g0 - 1) < 1e-4 and all(o.stable for o in br.orbits[1:])  # the first: neutral to 1e-5
+
+
+def test_contact_events_and_the_2d_switch(model, w33):
+    eq = Equilibria(model, "2D")
+    b = continue_static(eq, "g0", w33, 1.2e-3, 0.0)
+    assert b.complete
+    events = b.of_kind("contact")
+    assert len(events) >= 4
+    for e in events:
+        k = e.detail["point_index"]
+        gap = eq.contact(e.point.g0).gaps(e.point.q).ravel()[k]
+        assert abs(gap) <= 1e-9 * 1.2e-3  # the event is where the gap is zero
+    sw = b.of_kind("switch")
+    assert len(sw) == 1  # 2D: stability lost when the second blade touches (the point law's stiffness jumps)
+    assert sw[0].detail["left_real_part"] < 0 < sw[0].detail["right_real_part"]
+    assert not b.of_kind("hopf")  # at fixed speed the 2D spectrum is constant between events: no Hopf in g0
+
+
+def test_fold_in_speed(model):
+    """Through the hardening resonance at g0 = 2 mm (3D) the branch turns back: folds located where the
+    parameter's tangent component vanishes and the static Jacobian is singular."""
+    wr = model.params.normalisation.omega_ref
+    eq = Equilibria(model, "3D")
+    b = continue_static(eq, "omega", 2.0e-3, 3.45 * wr, 3.6 * wr, spectrum=False)
+    folds = b.of_kind("fold")
+    assert len(folds) >= 2 and b.complete
+    f = folds[0].point
+    J = eq.jacobian(f.q, f.omega, f.g0)
+    s_fold = np.linalg.svd(J, compute_uv=False)
+    p0 = b.points[0]
+    s_start = np.linalg.svd(eq.jacobian(p0.q, p0.omega, p0.g0), compute_uv=False)
+    assert s_fold[-1] / s_fold[0] < 1e-3 * s_start[-1] / s_start[0]
+    w = b.values()
+    k = int(np.argmin(np.abs(w - f.omega)))
+    assert (w[k - 3] - w[k]) * (w[k + 3] - w[k]) > 0  # the same side before and after: it turned
+
+
+def test_transient_settles_on_the_predicted_orbit(model, w33):
+    """2D, g0 = 0.33 mm (past the switch: the static solution is unstable, Re = +0.43 /s). The orbit is
+    predicted by continuing the orbit found at 0.30 mm; a transient started next to the unstable static
+    solution settles on it: amplitude within 2 %, period within 1 %."""
+    eq = Equilibria(model, "2D")
+    n = model.n_dofs
+    # the orbit at 0.30 mm, from a transient there, then continued to 0.33 mm and shot at exactly 0.33 mm
+    g_seed, g = 0.30e-3, 0.33e-3
+    q = eq.solve(w33, g_seed)
+    mu, _ = eq.critical(q, w33, g_seed)
+    mu, v = eq.refine(q, w33, g_seed, mu)
+    v = v / np.abs(eq._T2 @ v).max()
+    tr = run_transient(model, eq.contact(g_seed), w33, t_end=30.0, t_ramp=0.0, q0=q + 1e-5 * np.real(v),
+                       v0=1e-5 * np.real(mu * v), record_dt=5e-4)
+    seed = orbit_from_state(eq, w33, g_seed, tr.q[-1], (tr.q[-1] - tr.q[-2]) / (tr.t[1] - tr.t[0]),
+                            2 * np.pi / abs(mu.imag))
+    br = continue_orbits(eq, seed, g, max_orbits=30)
+    near = min(br.orbits, key=lambda o: abs(o.g0 - g))
+    pred = orbit_from_state(eq, w33, g, near.x0[:n], near.x0[n:], near.period)
+    assert pred is not None and pred.g0 == g and pred.residual < 1e-8
+    # the transient at 0.33 mm from the unstable static solution, at the orbit's own step
+    qs = eq.solve(w33, g)
+    mu_s, _ = eq.critical(qs, w33, g)
+    assert mu_s.real > 0.3
+    mu_s, vs = eq.refine(qs, w33, g, mu_s)
+    vs = vs / np.abs(eq._T2 @ vs).max()
+    dt = pred.period / 256
+    r = run_transient(model, eq.contact(g), w33, t_end=35.0, t_ramp=0.0, q0=qs + 1e-6 * np.real(vs),
+                      v0=1e-6 * np.real(mu_s * vs), record_dt=2 * dt, dt=dt)
+    assert not r.diverged
+    last = r.q[-int(2.0 / (2 * dt)):] @ eq._T2.T  # the last 2 s
+    assert np.ptp(last, axis=0).max() == pytest.approx(pred.disk_peak_to_peak, rel=0.02)
+    x = last[:, 0] - last[:, 0].mean()
+    up = np.flatnonzero((x[1:] > 0) & (x[:-1] <= 0))
+    assert np.mean(np.diff(up)) * 2 * dt == pytest.approx(pred.period, rel=0.01)
+    # and the amplitude it settles on is not the linear growth's: the static solution was 1 um away
+    assert pred.disk_peak_to_peak > 1e-4
+
+
+def test_boundary_curves_agree_with_a_grid_map(model):
+    """3D, a window left of the first critical (speeds 2.8-3.4, g0 0-0.8 mm) on a 13 x 13 grid: every
+    grid cell that contradicts the side of the traced curve lies within one cell of it."""
+    speeds, g0s = np.linspace(2.8, 3.4, 13), np.linspace(0.0, 0.8e-3, 13)
+    mp = run_stability_map(model, "3D", speeds, g0s, progress=False)
+    assert mp.unstable.any() and (mp.contact & ~mp.unstable).any()  # the window holds a boundary
+    curves, info = trace_boundaries(Equilibria(model, "3D"), speeds, g0s)
+    assert curves and all(k == "hopf" for c in curves for k in c.kinds)
+    a = agreement(curves, mp, tuple(info["cell"]))
+    assert a["regions"] >= 2
+    assert a["contradicting_beyond_one_cell"] == 0, a
