@@ -73,6 +73,7 @@ class BoundaryTracer:
         self.full_spectra = 0
         self.tracking = False  # while tracing, a solution far from its warm start is another branch: refused
         self.guard = False
+        self._rate: float | None = None  # |dq| per cell across the last brackets
         # the 3D chord law is C^1: the spectrum is continuous across contact events and the critical
         # eigenvalue can be followed through them; the 2D point law's stiffness jumps there
         self.continuous = eq.formulation == "3D"
@@ -154,7 +155,13 @@ class BoundaryTracer:
         def at(t: float, ref: Sample) -> Sample | None:
             return self.sample(a + t * (b - a), ref.q, ref)
 
-        tj = self._jump(a, b, sa) if depth == 0 else None
+        # a jump to another branch between a and b? Checked when the solutions differ much more than
+        # the last bracket's did per unit length (a fold), or when there is no such record yet
+        rate = np.linalg.norm(sb.q - sa.q) / np.linalg.norm(b - a)
+        suspect = self._rate is None or rate > 5.0 * self._rate
+        tj = self._jump(a, b, sa) if depth == 0 and suspect else None
+        if depth == 0 and tj is None:
+            self._rate = rate if self._rate is None else 0.5 * (self._rate + rate)
         if tj is not None:
             # the followed branch ends (a fold): the verdict changes with the branch
             return a + tj * (b - a), "fold", sa, sb
@@ -203,6 +210,7 @@ class BoundaryTracer:
 
     def trace(self, a: np.ndarray, b: np.ndarray, sa: Sample, sb: Sample, max_points: int = 4000) -> Curve | None:
         """The curve through the boundary point between a (stable) and b (unstable), both ways."""
+        self._rate = None
         first = self.locate(a, b, sa, sb)  # across a lattice edge: no continuity guard yet
         if first is None:
             return None
