@@ -42,8 +42,8 @@ def main(argv: list[str] | None = None) -> int:
     print(f"ratio curves / grid: {t_curves / t_grid:.2f} (target < 1)")
     for f, (cv, info) in curves.items():
         a = agreement(cv, maps[f], tuple(info["cell"]))
-        print(f"  {f}: {len(cv)} curves, {sum(len(c) for c in cv)} points, {info['evaluations']} equilibria; grid cells "
-              f"contradicting them: {a['contradicting_cells']} of {a['grid_cells']} "
+        print(f"  {f}: {len(cv)} curves, {sum(len(c) for c in cv)} points, {info['evaluations']} equilibria; "
+              f"grid cells contradicting them: {a['contradicting_cells']} of {a['grid_cells']} "
               f"({a['contradicting_beyond_one_cell']} beyond one cell)")
     return 0
 
