@@ -71,8 +71,7 @@ class BoundaryTracer:
         self.h_max = resolution
         self.evaluations = 0
         self.full_spectra = 0
-        self.tracking = False  # while tracing, a solution far from its warm start is another branch: refused
-        self.guard = False
+        self.tracking = False
         self._rate: float | None = None  # |dq| per cell across the last brackets
         # the 3D chord law is C^1: the spectrum is continuous across contact events and the critical
         # eigenvalue can be followed through them; the 2D point law's stiffness jumps there
@@ -93,12 +92,12 @@ class BoundaryTracer:
     def _solve(self, w: float, g: float, q0: np.ndarray | None) -> np.ndarray | None:
         """The balanced solution continued from q0; None where it is lost (a fold: the solver's other
         starts would land on another branch, which the maps do not follow either)."""
-        q = self.eq.solve(w, g, q0)
         self.evaluations += 1
-        if q is None or (self.tracking and self.guard and q0 is not None and
-                         np.linalg.norm(q - q0) > 0.25 * np.linalg.norm(q0) + 1e-7):
-            return None
-        return q
+        if q0 is not None:  # Newton from the neighbour first: cheap, and it stays on the branch
+            q = self.eq.solve(w, g, q0, follow=True)
+            if q is not None:
+                return q
+        return self.eq.solve(w, g, q0)  # then the solver's other starts, as the maps do
 
     def sample(self, p: np.ndarray, q0: np.ndarray | None, previous: Sample | None = None) -> Sample | None:
         """The balanced solution at p and its stability. With ``previous`` (in the same contact set,
@@ -125,22 +124,28 @@ class BoundaryTracer:
         qs = [sa.q]
         for t in ts[1:]:
             s_, g_ = self.from_xy(a + t * (b - a))
-            q = self.eq.solve(s_ * self.wref, g_, qs[-1])
+            q = self.eq.solve(s_ * self.wref, g_, qs[-1], follow=True)
             self.evaluations += 1
-            if q is None:
-                return None
+            if q is None:  # Newton lost the branch: it has ended (a fold) before this point
+                break
             qs.append(q)
         steps = np.array([np.linalg.norm(y - x) for x, y in zip(qs[:-1], qs[1:])])
-        k = int(np.argmax(steps))
-        rest = np.delete(steps, k)
-        if steps[k] <= 5.0 * max(float(np.median(rest)), 1e-3 * np.linalg.norm(sa.q) / n_sub):
-            return None
-        rate = float(np.median(rest)) / (ts[1] - ts[0])
+        floor = 1e-3 * np.linalg.norm(sa.q) / n_sub
+        if len(qs) < len(ts):  # lost: the end lies after the last solution found
+            k = len(qs) - 1
+            rate = (float(np.median(steps)) if len(steps) else floor) / (ts[1] - ts[0])
+        else:
+            k = int(np.argmax(steps))
+            rest = np.delete(steps, k)
+            if steps[k] <= 5.0 * max(float(np.median(rest)), floor):
+                return None
+            rate = float(np.median(rest)) / (ts[1] - ts[0])
+        rate = max(rate, floor / (ts[1] - ts[0]))
         lo, hi, q_lo = ts[k], ts[k + 1], qs[k]
         while hi - lo > 1e-6:
             mid = 0.5 * (lo + hi)
             s_, g_ = self.from_xy(a + mid * (b - a))
-            q = self.eq.solve(s_ * self.wref, g_, q_lo)
+            q = self.eq.solve(s_ * self.wref, g_, q_lo, follow=True)
             self.evaluations += 1
             if q is not None and np.linalg.norm(q - q_lo) <= 3.0 * rate * (mid - lo) + 1e-12:
                 lo, q_lo = mid, q
@@ -192,7 +197,7 @@ class BoundaryTracer:
         gb = float(self.eq.contact(sb.g0).gaps(sb.q).ravel()[k])
         if ga * gb >= 0 or depth > 6:
             return None
-        te = _regula_falsi(gap, ga, gb, 1e-9, 1e-8 * self.cg)
+        te = _regula_falsi(gap, ga, gb, 1e-7, 1e-6 * self.cg)  # 1e-6 of a cell
         if te is None:
             return None
         eps = 1e-5  # either side of the event, well beyond its location error
@@ -239,14 +244,19 @@ class BoundaryTracer:
                 got = self._bracket(c, n, ref, h)
                 if got is None:
                     h *= 0.5
-                    if h < 1e-3 * self.h_max:
+                    if h >= 0.05 * self.h_max:
+                        continue
+                    # a corner (a Hopf curve meeting a fold or switch curve): look round the point
+                    got = self._corner(p, tau, ref)
+                    if got is None:
                         break
-                    continue
+                    h = self.h_max
                 pn, kind, ra, rb = got
                 if len(pts) % 10 == 0:  # every tenth point: whole spectra, so that no other mode is missed
-                    fa, fb = self.sample(ra_xy(self, ra), ra.q), self.sample(ra_xy(self, rb), rb.q)
-                    ra, rb = fa or ra, fb or rb
-                smp = rb
+                    ra = self.sample(ra_xy(self, ra), ra.q) or ra
+                    if rb is not None:
+                        rb = self.sample(ra_xy(self, rb), rb.q) or rb
+                smp = rb if rb is not None else ra
                 step = pn - p
                 if np.linalg.norm(step) < 1e-9:
                     h *= 0.5
@@ -282,11 +292,43 @@ class BoundaryTracer:
             cv.normals.append((float(n[0]), float(n[1])))
         return cv
 
-    def _bracket(self, c: np.ndarray, n: np.ndarray, ref: tuple[Sample, Sample], h: float):
+    def _corner(self, p: np.ndarray, tau: np.ndarray, ref: tuple[Sample, Sample | None]):
+        """On a ring of radius h_max round p, the first verdict change ahead (within 150 degrees of
+        tau), located between the two ring points that disagree."""
+        r = self.h_max
+        ang0 = math.atan2(tau[1], tau[0])
+        angles = ang0 + np.radians(np.arange(-150, 151, 15))
+        ring = [p + r * np.array([math.cos(a), math.sin(a)]) for a in angles]
+        q0 = ref[0].q
+        samples = [self.sample(x, q0, ref[0]) if self.inside(x) else None for x in ring]
+        order = np.argsort(np.abs(angles - ang0))  # nearest to straight ahead first
+        for k in order:
+            for j in (k - 1, k + 1):
+                if not (0 <= j < len(ring)) or samples[k] is None or samples[j] is None:
+                    continue
+                sk, sj = samples[k], samples[j]
+                if sk.unstable == sj.unstable:
+                    continue
+                a, b, sa, sb = (ring[k], ring[j], sk, sj) if not sk.unstable else (ring[j], ring[k], sj, sk)
+                got = self.locate(a, b, sa, sb)
+                if got is not None:
+                    return got
+        return None
+
+    def _bracket(self, c: np.ndarray, n: np.ndarray, ref: tuple[Sample, Sample | None], h: float):
         for d in (0.5 * max(h, 0.05), 0.25, 0.6, 1.2):
             a, b = c - d * n, c + d * n  # may reach a cell past the range: g0 < 0 is an interference fit
-            sa, sb = self.sample(a, ref[0].q, ref[0]), self.sample(b, ref[1].q, ref[1])
-            if sa is None or sb is None:
+            sa = self.sample(a, ref[0].q, ref[0])
+            if sa is None:
+                continue
+            sb = self.sample(b, None if ref[1] is None else ref[1].q, ref[1])
+            if sb is None and not sa.unstable:
+                # no equilibrium on the far side: the stable branch ends between (a fold)
+                tj = self._jump(a, b, sa)
+                if tj is not None:
+                    return a + tj * (b - a), "fold", sa, None
+                continue
+            if sb is None:
                 continue
             if (not sa.unstable) and sb.unstable:
                 got = self.locate(a, b, sa, sb)
@@ -347,11 +389,12 @@ def crosses(curve: Curve, tr: BoundaryTracer, a: np.ndarray, b: np.ndarray) -> b
 
 
 def near(curve: Curve, tr: BoundaryTracer, a: np.ndarray, b: np.ndarray) -> bool:
-    """Does the curve pass within half a cell of the segment a-b's midpoint region (a seed it
-    already accounts for, where its polyline stopped short of the lattice edge)?"""
+    """Does the curve pass within a third of a cell of the segment a-b (a seed it already
+    accounts for, where its polyline stopped just short of the lattice edge)?"""
     P = np.array([tr.to_xy(s, g) for s, g in zip(curve.speeds, curve.g0s)])
-    m = 0.5 * (a + b)
-    return bool(np.min(np.linalg.norm(P - m, axis=1)) < 0.5 * np.linalg.norm(b - a))
+    d = b - a
+    t = np.clip((P - a) @ d / (d @ d), 0.0, 1.0)
+    return bool(np.min(np.linalg.norm(P - (a + t[:, None] * d), axis=1)) < 0.33)
 
 
 def _segments_intersect(a, b, c, d) -> bool:

@@ -135,6 +135,10 @@ def _declare(lib: ctypes.CDLL) -> ctypes.CDLL:
                                     ctypes.c_int, _dp,
                                     ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_int), _dp, _ip]
     lib.rr_static_solve.restype = ctypes.c_int
+    lib.rr_static_newton.argtypes = [ctypes.POINTER(RRContact), ctypes.c_double, _dp, _dp, ctypes.c_double,
+                                     ctypes.c_int, _dp, ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_int),
+                                     _dp, _ip]
+    lib.rr_static_newton.restype = ctypes.c_int
     lib.rr_blade_law.argtypes = [ctypes.c_int, ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_double,
                                  _dp]
     lib.rr_laws.argtypes = [c, _dp, _dp, _dp]

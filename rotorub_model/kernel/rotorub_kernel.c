@@ -921,6 +921,22 @@ static int newton(const rr_contact *c, double omega, int n, const double *K, con
     return nr <= tol * scale;
 }
 
+int rr_static_newton(const rr_contact *c, double omega, const double *K, const double *F, double tol, int max_iter,
+                     double *q, double *residual_out, int *iterations, double *work, int *iwork)
+{
+    int n = c->n, i, j, its = 0, ok;
+    double knorm = 0.0, rel = HUGE_VAL;
+    for (j = 0; j < n; ++j) {
+        double s = 0.0;
+        for (i = 0; i < n; ++i) s += fabs(K[(size_t)i * n + j]);
+        if (s > knorm) knorm = s;
+    }
+    ok = newton(c, omega, n, K, F, 1.0, knorm, tol, max_iter, q, &rel, &its, work, iwork);
+    *residual_out = rel;
+    *iterations = its;
+    return ok;
+}
+
 int rr_static_solve(const rr_contact *c, double omega, const double *K, const double *F, const double *q0,
                     double tol, int max_iter, double *q, double *residual_out, int *iterations, double *work,
                     int *iwork)

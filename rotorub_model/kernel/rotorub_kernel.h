@@ -241,6 +241,11 @@ RR_API int rr_static_solve(const rr_contact *c, double omega, const double *K, c
                            double tol, int max_iter, double *q, double *residual, int *iterations, double *work,
                            int *iwork);
 
+/* Newton from q alone (in/out; no other start, no continuation): the step of a continuation, which
+ * must stay on the branch it follows. Returns 1 (converged) or 0; work and iwork as rr_static_solve. */
+RR_API int rr_static_newton(const rr_contact *c, double omega, const double *K, const double *F, double tol,
+                            int max_iter, double *q, double *residual, int *iterations, double *work, int *iwork);
+
 /* The central-difference matrices at spin speed omega, angular acceleration omega_dot and step dt,
  * assembled in the library's order of operations: C = D + omega G1,
  * K = K0 + omega^2 (S2 + N2) + omega C1 + omega_dot E1 (E1 may be NULL),
