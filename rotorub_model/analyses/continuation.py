@@ -115,14 +115,19 @@ class ContinuationResult:
                 k = np.array(c.kinds)
                 s, g = np.array(c.speeds), np.array(c.g0s) * 1e3
                 ax.plot(s, g, "-", color="k", lw=1.2, label="boundary (continuation)" if i == 0 else None)
-                ax.plot(s[k == "hopf"], g[k == "hopf"], ".", color="C0", ms=2, label="Hopf" if i == 0 else None)
+                for kind, col in (("hopf", "C0"), ("switch", "C1"), ("fold", "C4")):
+                    sel = k == kind
+                    if sel.any():
+                        ax.plot(s[sel], g[sel], ".", color=col, ms=2, label=kind)
             ax.set_xlabel("Ω / Ω_ref")
             ax.set_ylabel("clearance g0 [mm]")
             ag = self.agreement.get(f, {})
             ax.set_title(f"{f}: stability boundary; grid cells off the curve's verdict: "
                          f"{ag.get('contradicting_cells', '?')} ({ag.get('contradicting_beyond_one_cell', '?')} beyond "
                          "one cell)", fontsize=8)
-            ax.legend(fontsize=7)
+            h, lab = ax.get_legend_handles_labels()
+            uniq = dict(zip(lab, h))
+            ax.legend(uniq.values(), uniq.keys(), fontsize=7)
             ax.grid(alpha=0.3)
         return save_figure(fig, path)
 
