@@ -12,6 +12,16 @@ from rotorub_model.structure.params import reference_parameters
 
 
 @pytest.fixture(scope="session")
+def undamped():
+    """Reference model with every damper removed (for energy and time-step checks)."""
+    p = reference_parameters()
+    bearings = [{"name": b.name, "z": b.z, "k": b.k, "c": 0.0} for b in p.bearings]
+    p = p.replace(bearings=bearings, blades={"damping_ratio": 0.0}, casing={"damping_ratio": 0.0},
+                  suspension={"c_translation": 0.0, "c_rotation": 0.0})
+    return build_model(p)
+
+
+@pytest.fixture(scope="session")
 def ref_params():
     """The embedded reference parameters (frozen dataclasses: safe to share)."""
     return reference_parameters()

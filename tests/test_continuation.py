@@ -33,6 +33,15 @@ def hopf_3d(model, w33):
     return eq, b
 
 
+def settled(r, eq: Equilibria, record_dt: float) -> tuple[float, float]:
+    """Over a transient's last 2 s: the fan disk's largest peak-to-peak [m] and the period [s] from
+    the upward crossings of its mean."""
+    last = r.q[-int(2.0 / record_dt):] @ eq._T2.T
+    x = last[:, 0] - last[:, 0].mean()
+    up = np.flatnonzero((x[1:] > 0) & (x[:-1] <= 0))
+    return float(np.ptp(last, axis=0).max()), float(np.mean(np.diff(up)) * record_dt)
+
+
 def test_hopf_point_is_located_to_1e_8(hopf_3d, w33):
     eq, b = hopf_3d
     assert b.complete
@@ -112,10 +121,8 @@ def test_transient_settles_on_the_predicted_orbit(model, w33):
     g_seed, g = 0.30e-3, 0.33e-3
     q = eq.solve(w33, g_seed)
     mu, _ = eq.critical(q, w33, g_seed)
-    mu, v = eq.refine(q, w33, g_seed, mu)
-    v = v / np.abs(eq._T2 @ v).max()
-    tr = run_transient(model, eq.contact(g_seed), w33, t_end=30.0, t_ramp=0.0, q0=q + 1e-5 * np.real(v),
-                       v0=1e-5 * np.real(mu * v), record_dt=5e-4)
+    q0, v0 = eq.unstable_start(q, w33, g_seed, mu, 1e-5)
+    tr = run_transient(model, eq.contact(g_seed), w33, t_end=30.0, t_ramp=0.0, q0=q0, v0=v0, record_dt=5e-4)
     seed = orbit_from_state(eq, w33, g_seed, tr.q[-1], (tr.q[-1] - tr.q[-2]) / (tr.t[1] - tr.t[0]),
                             2 * np.pi / abs(mu.imag))
     br = continue_orbits(eq, seed, g, max_orbits=30)
@@ -126,17 +133,13 @@ def test_transient_settles_on_the_predicted_orbit(model, w33):
     qs = eq.solve(w33, g)
     mu_s, _ = eq.critical(qs, w33, g)
     assert mu_s.real > 0.3
-    mu_s, vs = eq.refine(qs, w33, g, mu_s)
-    vs = vs / np.abs(eq._T2 @ vs).max()
+    q0, v0 = eq.unstable_start(qs, w33, g, mu_s, 1e-6)
     dt = pred.period / 256
-    r = run_transient(model, eq.contact(g), w33, t_end=35.0, t_ramp=0.0, q0=qs + 1e-6 * np.real(vs),
-                      v0=1e-6 * np.real(mu_s * vs), record_dt=2 * dt, dt=dt)
+    r = run_transient(model, eq.contact(g), w33, t_end=35.0, t_ramp=0.0, q0=q0, v0=v0, record_dt=2 * dt, dt=dt)
     assert not r.diverged
-    last = r.q[-int(2.0 / (2 * dt)):] @ eq._T2.T  # the last 2 s
-    assert np.ptp(last, axis=0).max() == pytest.approx(pred.disk_peak_to_peak, rel=0.02)
-    x = last[:, 0] - last[:, 0].mean()
-    up = np.flatnonzero((x[1:] > 0) & (x[:-1] <= 0))
-    assert np.mean(np.diff(up)) * 2 * dt == pytest.approx(pred.period, rel=0.01)
+    ptp, period = settled(r, eq, 2 * dt)
+    assert ptp == pytest.approx(pred.disk_peak_to_peak, rel=0.02)
+    assert period == pytest.approx(pred.period, rel=0.01)
     # and the amplitude it settles on is not the linear growth's: the static solution was 1 um away
     assert pred.disk_peak_to_peak > 1e-4
 
@@ -174,15 +177,10 @@ def test_transient_settles_on_the_orbit_born_at_the_hopf_point(hopf_3d, model, w
     qs = eq.solve(w33, g)
     mu, _ = eq.critical(qs, w33, g)
     assert mu.real > 0.02
-    mu, v = eq.refine(qs, w33, g, mu)
-    v = v / np.abs(eq._T2 @ v).max()
-    amp = 0.25 * pred.disk_peak_to_peak
+    q0, v0 = eq.unstable_start(qs, w33, g, mu, 0.25 * pred.disk_peak_to_peak)
     dt = pred.period / 128
-    r = run_transient(model, eq.contact(g), w33, t_end=100.0, t_ramp=0.0, q0=qs + amp * np.real(v),
-                      v0=amp * np.real(mu * v), record_dt=2 * dt, dt=dt)
+    r = run_transient(model, eq.contact(g), w33, t_end=100.0, t_ramp=0.0, q0=q0, v0=v0, record_dt=2 * dt, dt=dt)
     assert not r.diverged
-    last = r.q[-int(2.0 / (2 * dt)):] @ eq._T2.T
-    assert np.ptp(last, axis=0).max() == pytest.approx(pred.disk_peak_to_peak, rel=0.02)
-    x = last[:, 0] - last[:, 0].mean()
-    up = np.flatnonzero((x[1:] > 0) & (x[:-1] <= 0))
-    assert np.mean(np.diff(up)) * 2 * dt == pytest.approx(pred.period, rel=0.01)
+    ptp, period = settled(r, eq, 2 * dt)
+    assert ptp == pytest.approx(pred.disk_peak_to_peak, rel=0.02)
+    assert period == pytest.approx(pred.period, rel=0.01)

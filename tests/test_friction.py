@@ -20,21 +20,11 @@ from rotorub_model.analyses.transient import run_transient
 from rotorub_model.contact import make_contact
 from rotorub_model.errors import ParameterError
 from rotorub_model.structure.model import build_model
-from rotorub_model.structure.params import reference_parameters
 
 
 @pytest.fixture(scope="module")
 def model():
     return build_model()
-
-
-@pytest.fixture(scope="module")
-def undamped():
-    p = reference_parameters()
-    bearings = [{"name": b.name, "z": b.z, "k": b.k, "c": 0.0} for b in p.bearings]
-    p = p.replace(bearings=bearings, blades={"damping_ratio": 0.0}, casing={"damping_ratio": 0.0},
-                  suspension={"c_translation": 0.0, "c_rotation": 0.0})
-    return build_model(p)
 
 
 def touching_state(model, form, frac=0.5):

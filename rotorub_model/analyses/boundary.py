@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .equilibria import Equilibria
+from .roots import illinois
 from .stability import RE_TOL
 
 
@@ -181,7 +182,7 @@ class BoundaryTracer:
                 state["s"] = smp
                 return smp.mu.real
 
-            t = _regula_falsi(re, sa.mu.real, sb.mu.real, 1e-7, 1e-8)
+            t = illinois(re, sa.mu.real, sb.mu.real, 1e-7, 1e-8, max_iter=80)
             if t is None:
                 return None
             return a + t * (b - a), "hopf", sa, state["s"]
@@ -197,7 +198,7 @@ class BoundaryTracer:
         gb = float(self.eq.contact(sb.g0).gaps(sb.q).ravel()[k])
         if ga * gb >= 0 or depth > 6:
             return None
-        te = _regula_falsi(gap, ga, gb, 1e-7, 1e-6 * self.cg)  # 1e-6 of a cell
+        te = illinois(gap, ga, gb, 1e-7, 1e-6 * self.cg, max_iter=80)  # 1e-6 of a cell
         if te is None:
             return None
         eps = 1e-5  # either side of the event, well beyond its location error
@@ -253,9 +254,9 @@ class BoundaryTracer:
                     h = self.h_max
                 pn, kind, ra, rb = got
                 if len(pts) % 10 == 0:  # every tenth point: whole spectra, so that no other mode is missed
-                    ra = self.sample(ra_xy(self, ra), ra.q) or ra
+                    ra = self.sample(self.to_xy(ra.omega / self.wref, ra.g0), ra.q) or ra
                     if rb is not None:
-                        rb = self.sample(ra_xy(self, rb), rb.q) or rb
+                        rb = self.sample(self.to_xy(rb.omega / self.wref, rb.g0), rb.q) or rb
                 smp = rb if rb is not None else ra
                 step = pn - p
                 if np.linalg.norm(step) < 1e-9:
@@ -340,10 +341,6 @@ class BoundaryTracer:
         return None
 
 
-def ra_xy(tr: BoundaryTracer, smp: Sample) -> np.ndarray:
-    return tr.to_xy(smp.omega / tr.wref, smp.g0)
-
-
 def _clip_to_box(p, c, tr: BoundaryTracer):
     lo = tr.to_xy(tr.s_lo, tr.g_lo)
     hi = tr.to_xy(tr.s_hi, tr.g_hi)
@@ -355,28 +352,6 @@ def _clip_to_box(p, c, tr: BoundaryTracer):
         if d[i] < 0 and c[i] < lo[i]:
             t = min(t, (lo[i] - p[i]) / d[i])
     return p + max(t, 0.0) * d
-
-
-def _regula_falsi(f, fa: float, fb: float, tol_t: float, f_tol: float, max_iter: int = 80):
-    a, b, side = 0.0, 1.0, 0
-    for _ in range(max_iter):
-        t = (a * fb - b * fa) / (fb - fa) if fb != fa else 0.5 * (a + b)
-        ft = f(t)
-        if ft is None:
-            return None
-        if abs(ft) <= f_tol or (b - a) <= tol_t:
-            return t
-        if (ft > 0) == (fb > 0):
-            b, fb = t, ft
-            if side == 1:
-                fa *= 0.5
-            side = 1
-        else:
-            a, fa = t, ft
-            if side == -1:
-                fb *= 0.5
-            side = -1
-    return t
 
 
 def crosses(curve: Curve, tr: BoundaryTracer, a: np.ndarray, b: np.ndarray) -> bool:

@@ -27,6 +27,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from .equilibria import Equilibria, Point
+from .roots import illinois
 from .stability import RE_TOL
 
 
@@ -135,34 +136,6 @@ class _Tracer:
         return self.eq.point(q, w, g, spectrum)
 
 
-def _illinois(f, fa: float, fb: float, tol_x: float, f_tol: float = 0.0, max_iter: int = 60):
-    """Root of f on [0, 1] with f(0) = fa, f(1) = fb of opposite signs (Illinois regula falsi)."""
-    a, b = 0.0, 1.0
-    side = 0
-    x, fx = a, fa
-    for _ in range(max_iter):
-        x = (a * fb - b * fa) / (fb - fa)
-        fx = f(x)
-        if fx is None:
-            x = 0.5 * (a + b)
-            fx = f(x)
-            if fx is None:
-                return None
-        if abs(fx) <= f_tol or (b - a) <= tol_x:
-            return x
-        if (fx > 0) == (fb > 0):
-            b, fb = x, fx
-            if side == 1:
-                fa *= 0.5
-            side = 1
-        else:
-            a, fa = x, fx
-            if side == -1:
-                fb *= 0.5
-            side = -1
-    return x
-
-
 def continue_static(eq: Equilibria, parameter: str, fixed: float, start: float, stop: float,
                     q0: np.ndarray | None = None, h_max: float = 0.01, max_points: int = 5000,
                     spectrum: bool = True) -> Branch:
@@ -234,7 +207,7 @@ def _locate(tr: _Tracer, ya: np.ndarray, yb: np.ndarray, pa: Point, pb: Point, t
             y = tr.on_chord(ya, yb, s)
             return None if y is None else tr.tangent(y, ta, 1.0)[-1]
 
-        s = _illinois(tp, ta[-1], tb[-1], 1e-9)
+        s = illinois(tp, ta[-1], tb[-1], 1e-9, retry_midpoint=True)
         if s is not None:
             y = tr.on_chord(ya, yb, s)
             if y is not None:
@@ -254,7 +227,7 @@ def _locate(tr: _Tracer, ya: np.ndarray, yb: np.ndarray, pa: Point, pb: Point, t
         ga = float(tr.eq.contact(pa.g0).gaps(pa.q).ravel()[k])
         gb = float(tr.eq.contact(pb.g0).gaps(pb.q).ravel()[k])
         if ga * gb < 0:
-            s_event = _illinois(gap, ga, gb, 1e-9, f_tol=1e-15)
+            s_event = illinois(gap, ga, gb, 1e-9, f_tol=1e-15, retry_midpoint=True)
         if s_event is not None:
             y = tr.on_chord(ya, yb, s_event)
             if y is not None:
@@ -301,7 +274,7 @@ def _hopf(tr: _Tracer, ya: np.ndarray, yb: np.ndarray, s0: float, s1: float, pa:
         state["mu"], state["v"], state["y"] = mu, v, y
         return mu.real
 
-    frac = _illinois(re, pa.mu.real, pb.mu.real, 1e-12, f_tol=1e-10)
+    frac = illinois(re, pa.mu.real, pb.mu.real, 1e-12, f_tol=1e-10, retry_midpoint=True)
     y = tr.on_chord(ya, yb, s0 + frac * (s1 - s0))
     pt = tr.point(y, False)
     q, p = tr.unpack(y)

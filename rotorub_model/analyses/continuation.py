@@ -94,9 +94,7 @@ class ContinuationResult:
             ax.set_xlabel("clearance g0 [mm]")
             ax.set_ylabel("largest blade normal force [N] (orbits: over the period)")
             ax.set_title(f"{f}, Ω = {self.speed:g} Ω_ref")
-            h, lab = ax.get_legend_handles_labels()
-            uniq = dict(zip(lab, h))
-            ax.legend(uniq.values(), uniq.keys(), fontsize=7)
+            _legend(ax)
             ax.grid(alpha=0.3)
         return save_figure(fig, path)
 
@@ -125,9 +123,7 @@ class ContinuationResult:
             ax.set_title(f"{f}: stability boundary; grid cells off the curve's verdict: "
                          f"{ag.get('contradicting_cells', '?')} ({ag.get('contradicting_beyond_one_cell', '?')} beyond "
                          "one cell)", fontsize=8)
-            h, lab = ax.get_legend_handles_labels()
-            uniq = dict(zip(lab, h))
-            ax.legend(uniq.values(), uniq.keys(), fontsize=7)
+            _legend(ax)
             ax.grid(alpha=0.3)
         return save_figure(fig, path)
 
@@ -140,6 +136,13 @@ class ContinuationResult:
         s = self.summary()
         write_json(out / "summary.json", s)
         return s
+
+
+def _legend(ax) -> None:
+    """One legend entry per label (the branches and curves repeat theirs)."""
+    h, lab = ax.get_legend_handles_labels()
+    uniq = dict(zip(lab, h))
+    ax.legend(uniq.values(), uniq.keys(), fontsize=7)
 
 
 def agreement(curves: list[Curve], mp: StabilityMap, cell: tuple[float, float]) -> dict:
@@ -214,11 +217,9 @@ def _orbits_2d(eq: Equilibria, branch: Branch, omega: float, max_orbits: int) ->
     p = unstable[0]
     g0 = p.g0
     q = p.q
-    mu, v = eq.refine(q, omega, g0, p.mu)
-    v = v / np.abs(eq._T2 @ v).max()
-    amp = 1e-5
-    tr = run_transient(eq.model, eq.contact(g0), omega, t_end=40.0, t_ramp=0.0, me=eq.me, q0=q + amp * np.real(v),
-                       v0=amp * np.real(mu * v), record_dt=5e-4, max_penetration=0.01)
+    q0, v0 = eq.unstable_start(q, omega, g0, p.mu, 1e-5)
+    tr = run_transient(eq.model, eq.contact(g0), omega, t_end=40.0, t_ramp=0.0, me=eq.me, q0=q0, v0=v0,
+                       record_dt=5e-4, max_penetration=0.01)
     if tr.diverged or len(tr.q) < 100:
         return [OrbitBranch(eq.formulation, omega, [], f"the transient at g0 = {g0:.4g} m diverged: no orbit")]
     d = tr.q[-4000:] @ eq._T2.T

@@ -125,12 +125,20 @@ class Equilibria:
         return tuple(bool(x) for x in (self.contact(g0).gaps(q) < 0.0).ravel())
 
     def point(self, q: np.ndarray, omega: float, g0: float, spectrum: bool = True) -> Point:
-        laws = self.contact(g0).laws(q)
-        p = Point(float(omega), float(g0), q, self.contact_set(q, g0), int(np.sum(laws[:, 0] > 0)),
-                  float(laws[:, 0].max()), float(np.hypot(*(self._T2 @ q))))
+        gaps, laws = self.contact(g0)._eval(q)  # one evaluation of the law for both
+        p = Point(float(omega), float(g0), q, tuple(bool(x) for x in (gaps < 0.0).ravel()),
+                  int(np.sum(laws[:, 0] > 0)), float(laws[:, 0].max()), float(np.hypot(*(self._T2 @ q))))
         if spectrum:
             p.mu, p.max_real = self.critical(q, omega, g0)
         return p
+
+    def unstable_start(self, q: np.ndarray, omega: float, g0: float, mu: complex,
+                       amplitude: float) -> tuple[np.ndarray, np.ndarray]:
+        """(q0, v0) next to the balanced solution q along the eigenvector of mu (refined), scaled so
+        that the fan-disk moves by ``amplitude`` [m]: where a transient leaves an unstable solution."""
+        mu, v = self.refine(q, omega, g0, mu)
+        v = v / np.abs(self._T2 @ v).max()
+        return q + amplitude * np.real(v), amplitude * np.real(mu * v)
 
     # ------------------------------------------------------------------ linearisation
     def linearisation(self, q: np.ndarray, omega: float, g0: float) -> tuple[np.ndarray, np.ndarray]:

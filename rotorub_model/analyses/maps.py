@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..contact import make_contact
-from ..results import pyplot, save_figure, write_json
+from ..results import pyplot, save_figure, save_result
 from ..structure.model import Model, build_model
 from ..structure.params import from_dict, to_dict
 from .stability import stability_of
@@ -168,14 +168,10 @@ class StabilityMap:
                    d["sum_pos"], d["converged"])
 
     def save(self, out: str | Path) -> dict:
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
         stem = f"stability_{self.formulation}"
-        self.plot(out / f"{stem}.png")
-        np.savez(out / f"{stem}.npz", speeds=self.speeds, g0s=self.g0s, n_contact=self.n_contact,
+        s = save_result(self, out, stem)
+        np.savez(Path(out) / f"{stem}.npz", speeds=self.speeds, g0s=self.g0s, n_contact=self.n_contact,
                  chord_total=self.chord_total, max_real=self.max_real, sum_pos=self.sum_pos, converged=self.converged)
-        s = self.summary()
-        write_json(out / f"{stem}.json", s)
         return s
 
 

@@ -214,8 +214,7 @@ def continue_orbits_from_hopf(eq: Equilibria, omega: float, g0_hopf: float, mu: 
     w = abs(mu.imag)
     T_h = 2 * math.pi / w
     n = eq.n
-    disk = eq._T2
-    k = int(np.argmax(np.abs(disk @ np.eye(n)).max(axis=0) * np.abs(v)))
+    k = int(np.argmax(np.abs(eq._T2).max(axis=0) * np.abs(v)))  # the disk dof the mode moves most
     # rotate the eigenvector so that its velocity at the section dof is zero (x = Re(v), v_k real)
     v = v * np.exp(-1j * np.angle(v[k]))
     e_q, e_v = np.real(v), np.real(mu * v)

@@ -41,7 +41,7 @@ import numpy as np
 from .. import kernel
 from ..contact import ContactModel
 from ..errors import ParameterError
-from ..results import pyplot, save_figure, write_json
+from ..results import pyplot, save_figure, save_result
 from ..structure.model import Model
 
 
@@ -317,13 +317,9 @@ class TransientResult:
         return save_figure(fig, path)
 
     def save(self, out: str | Path, stem: str | None = None) -> dict:
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
         stem = stem or f"transient_{self.formulation}"
-        self.plot(out / f"{stem}.png")
-        np.savez_compressed(out / f"{stem}.npz", t=self.t, q=self.q, omega=self.omega, **self.outputs)
-        s = self.summary()
-        write_json(out / f"{stem}.json", s)
+        s = save_result(self, out, stem)
+        np.savez_compressed(Path(out) / f"{stem}.npz", t=self.t, q=self.q, omega=self.omega, **self.outputs)
         return s
 
 

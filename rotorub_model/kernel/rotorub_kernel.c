@@ -921,17 +921,25 @@ static int newton(const rr_contact *c, double omega, int n, const double *K, con
     return nr <= tol * scale;
 }
 
-int rr_static_newton(const rr_contact *c, double omega, const double *K, const double *F, double tol, int max_iter,
-                     double *q, double *residual_out, int *iterations, double *work, int *iwork)
+/* the 1-norm (largest column sum) of an n x n matrix: the scale of |R| when there is no force */
+static double norm1(int n, const double *K)
 {
-    int n = c->n, i, j, its = 0, ok;
-    double knorm = 0.0, rel = HUGE_VAL;
+    double big = 0.0;
+    int i, j;
     for (j = 0; j < n; ++j) {
         double s = 0.0;
         for (i = 0; i < n; ++i) s += fabs(K[(size_t)i * n + j]);
-        if (s > knorm) knorm = s;
+        if (s > big) big = s;
     }
-    ok = newton(c, omega, n, K, F, 1.0, knorm, tol, max_iter, q, &rel, &its, work, iwork);
+    return big;
+}
+
+int rr_static_newton(const rr_contact *c, double omega, const double *K, const double *F, double tol, int max_iter,
+                     double *q, double *residual_out, int *iterations, double *work, int *iwork)
+{
+    int n = c->n, its = 0, ok;
+    double rel = HUGE_VAL;
+    ok = newton(c, omega, n, K, F, 1.0, norm1(n, K), tol, max_iter, q, &rel, &its, work, iwork);
     *residual_out = rel;
     *iterations = its;
     return ok;
@@ -941,7 +949,7 @@ int rr_static_solve(const rr_contact *c, double omega, const double *K, const do
                     double tol, int max_iter, double *q, double *residual_out, int *iterations, double *work,
                     int *iwork)
 {
-    int n = c->n, i, j, k, ok = 0, its = 0, n_start;
+    int n = c->n, i, k, ok = 0, its = 0, n_start;
     double *nw = work;                               /* newton: n*n + 5n */
     double *qlin = work + (size_t)n * n + 5 * (size_t)n;
     double *best = qlin + n, *start = best + n;      /* + 3n */
@@ -949,11 +957,7 @@ int rr_static_solve(const rr_contact *c, double omega, const double *K, const do
     double knorm = 0.0, rel = HUGE_VAL, best_rel = HUGE_VAL;
     static const double fracs[3] = {1.0, 0.5, 0.1}, scales[4] = {0.5, 0.25, 1.5, 2.0};
     int have_kc = 0;
-    for (j = 0; j < n; ++j) {
-        double s = 0.0;
-        for (i = 0; i < n; ++i) s += fabs(K[(size_t)i * n + j]);
-        if (s > knorm) knorm = s;
-    }
+    knorm = norm1(n, K);
     /* the linear response */
     for (i = 0; i < n * n; ++i) nw[i] = K[i];
     if (rr_lu(n, nw, iwork) != 0) {
