@@ -109,7 +109,7 @@ def main(argv: list[str] | None = None) -> int:
         def bare_run():
             q[:] = 0.0
             qp[:] = 0.0
-            bare.bare_cd(c.kernel, mats, kernel.ptr(q), kernel.ptr(qp), n_sub, me)
+            bare.bare_cd(c.kernel, mats, kernel.ptr(q), kernel.ptr(qp), h / 2, omega, n_sub, me)
 
         bare_run()
         t_bare = best(bare_run, ns.repeat) / (ns.steps - 1)
