@@ -42,6 +42,8 @@ class Sample:
     contact_set: tuple
     mu: complex  # critical eigenvalue (Im > 0), refined
     max_real: float
+    v: np.ndarray | None = None  # its eigenvector (warm start of the next refinement)
+    event: int | None = None  # on a switch or fold curve: the contact point whose gap is zero there
 
     @property
     def unstable(self) -> bool:
@@ -77,6 +79,9 @@ class BoundaryTracer:
         # the 3D chord law is C^1: the spectrum is continuous across contact events and the critical
         # eigenvalue can be followed through them; the 2D point law's stiffness jumps there
         self.continuous = eq.formulation == "3D"
+        self._by_set: dict[tuple, Sample] = {}
+        self._re_slope: float | None = None  # d Re(mu) / d(offset along the normal) at the last Hopf point [1/s/cell]
+        self._gap_slope: dict[str, float] = {}  # d(signed gap) / d(offset), each side of the last event
 
     # ------------------------------------------------------------------ coordinates
     def to_xy(self, speed: float, g0: float) -> np.ndarray:
@@ -109,14 +114,21 @@ class BoundaryTracer:
         if q is None:
             return None
         cset = self.eq.contact_set(q, g)
-        if previous is not None and (cset == previous.contact_set or self.continuous):
-            mu, _ = self.eq.refine(q, w, g, previous.mu)
+        if previous is not None and not (cset == previous.contact_set or self.continuous):
+            # 2D: the linearisation depends on the contact set (and the speed) only, so the last
+            # sample seen with this set is as good a start as a neighbour
+            previous = self._by_set.get(cset)
+        if previous is not None:
+            mu, v = self.eq.refine(q, w, g, previous.mu, previous.v)
             if abs(mu - previous.mu) < 0.05 * abs(previous.mu):
                 others = previous.max_real if previous.max_real > previous.mu.real + 1e-9 else -math.inf
-                return Sample(w, g, q, cset, mu, max(mu.real, others))
+                smp = Sample(w, g, q, cset, mu, max(mu.real, others), v)
+                self._by_set[cset] = smp
+                return smp
         mu, mr = self.eq.critical(q, w, g)
         self.full_spectra += 1
-        return Sample(w, g, q, cset, mu, mr)
+        smp = self._by_set[cset] = Sample(w, g, q, cset, mu, mr)
+        return smp
 
     def _jump(self, a: np.ndarray, b: np.ndarray, sa: Sample, n_sub: int = 6) -> float | None:
         """Where the balanced solution continued from a towards b jumps to another branch (a fold of
@@ -143,10 +155,13 @@ class BoundaryTracer:
             rate = float(np.median(rest)) / (ts[1] - ts[0])
         rate = max(rate, floor / (ts[1] - ts[0]))
         lo, hi, q_lo = ts[k], ts[k + 1], qs[k]
+        # 2D: from a start this close, Newton on the piecewise-linear law converges in one to three
+        # iterations or has lost the branch (a lost one would otherwise spend ten on line searches)
+        its = None if self.continuous else 4
         while hi - lo > 1e-6:
             mid = 0.5 * (lo + hi)
             s_, g_ = self.from_xy(a + mid * (b - a))
-            q = self.eq.solve(s_ * self.wref, g_, q_lo, follow=True)
+            q = self.eq.solve(s_ * self.wref, g_, q_lo, follow=True, max_iter=its)
             self.evaluations += 1
             if q is not None and np.linalg.norm(q - q_lo) <= 3.0 * rate * (mid - lo) + 1e-12:
                 lo, q_lo = mid, q
@@ -165,12 +180,12 @@ class BoundaryTracer:
         # the last bracket's did per unit length (a fold), or when there is no such record yet
         rate = np.linalg.norm(sb.q - sa.q) / np.linalg.norm(b - a)
         suspect = self._rate is None or rate > 5.0 * self._rate
-        tj = self._jump(a, b, sa) if depth == 0 and suspect else None
-        if depth == 0 and tj is None:
+        jump = self._jump(a, b, sa) if depth == 0 and suspect else None
+        if depth == 0 and jump is None:
             self._rate = rate if self._rate is None else 0.5 * (self._rate + rate)
-        if tj is not None:
+        if jump is not None:
             # the followed branch ends (a fold): the verdict changes with the branch
-            return a + tj * (b - a), "fold", sa, sb
+            return a + jump * (b - a), "fold", sa, sb
 
         if sa.contact_set == sb.contact_set or self.continuous:
             state = {"s": sb}
@@ -185,6 +200,7 @@ class BoundaryTracer:
             t = illinois(re, sa.mu.real, sb.mu.real, 1e-7, 1e-8, max_iter=80)
             if t is None:
                 return None
+            self._re_slope = (sb.mu.real - sa.mu.real) / float(np.linalg.norm(b - a))
             return a + t * (b - a), "hopf", sa, state["s"]
         # a contact event in between: where the first differing point's gap crosses zero
         k = next(i for i, (x, y) in enumerate(zip(sa.contact_set, sb.contact_set)) if x != y)
@@ -192,10 +208,10 @@ class BoundaryTracer:
         def gap(t):
             s_, g_ = self.from_xy(a + t * (b - a))
             q = self._solve(s_ * self.wref, g_, sa.q)  # the gap needs no spectrum
-            return None if q is None else float(self.eq.contact(g_).gaps(q).ravel()[k])
+            return None if q is None else float(self.eq.gaps(q, g_).ravel()[k])
 
-        ga = float(self.eq.contact(sa.g0).gaps(sa.q).ravel()[k])
-        gb = float(self.eq.contact(sb.g0).gaps(sb.q).ravel()[k])
+        ga = float(self.eq.gaps(sa.q, sa.g0).ravel()[k])
+        gb = float(self.eq.gaps(sb.q, sb.g0).ravel()[k])
         if ga * gb >= 0 or depth > 6:
             return None
         te = illinois(gap, ga, gb, 1e-7, 1e-6 * self.cg, max_iter=80)  # 1e-6 of a cell
@@ -208,15 +224,191 @@ class BoundaryTracer:
         if left is None or right is None:
             return None
         if left.unstable != right.unstable:
+            left.event = right.event = k
             return a + te * (b - a), "switch", left, right
         pa, pb = a + max(te - eps, 0.0) * (b - a), a + min(te + eps, 1.0) * (b - a)
         if left.unstable:  # the crossing is before the event
             return self.locate(a, pa, sa, left, depth + 1)
         return self.locate(pb, b, right, sb, depth + 1)
 
+    # ------------------------------------------------------------------ the fast corrector
+    # Along a curve the kind of boundary and (for an event) the contact point are known from the
+    # last point, so the corrector solves for the offset along the normal by Newton/secant on the
+    # quantity that vanishes there (Re mu, or the point's gap), started from the slope the last
+    # point measured: two or three balanced solutions where a bracket and regula falsi took ten.
+    # It returns None whenever what it finds is not the verified boundary (a jump, another mode,
+    # a verdict that does not change), and the bracketing corrector takes over.
+
+    def _xy(self, smp: Sample) -> np.ndarray:
+        return self.to_xy(smp.omega / self.wref, smp.g0)
+
+    def _continues(self, q_from: np.ndarray, x_from: np.ndarray, q_to: np.ndarray, x_to: np.ndarray) -> bool:
+        """Is q_to on the branch of q_from: a change per cell within 5x the recent rate (no jump)?"""
+        if self._rate is None:
+            return False
+        dq = float(np.linalg.norm(q_to - q_from))
+        return dq <= 5.0 * self._rate * float(np.linalg.norm(x_to - x_from)) + 1e-9 * float(np.linalg.norm(q_from))
+
+    def _note_rate(self, q_from, x_from, q_to, x_to) -> None:
+        dx = float(np.linalg.norm(x_to - x_from))
+        if dx > 1e-3 and self._rate is not None:
+            self._rate = 0.5 * (self._rate + float(np.linalg.norm(q_to - q_from)) / dx)
+
+    def _fast(self, c: np.ndarray, n: np.ndarray, kind: str, ref: tuple[Sample, Sample | None]):
+        ra, rb = ref
+        if kind == "hopf" and self.continuous and self._re_slope and self._re_slope > 0:
+            return self._fast_hopf(c, n, ra)
+        if kind == "switch" and not self.continuous and ra.event is not None:
+            return self._fast_event(c, n, ra, rb)
+        if kind == "fold" and self.continuous and self._rate is not None:
+            # 3D: a smooth fold. In 2D the followed branch "ends" where Newton from the neighbour jumps
+            # at a contact event, also where the piecewise-linear branch goes on (same orientation):
+            # what the maps see there is what the bracketing corrector's jump search reproduces
+            return self._fast_fold(c, n, ra, rb)
+        return None
+
+    def _fast_fold(self, c: np.ndarray, n: np.ndarray, ra: Sample, rb: Sample | None, d: float = 0.02):
+        """The end of the followed branch on the normal line through c, bisected from a bracket of
+        +-d cells (the last fold point's continuation puts it near c) to 1e-6 cells. On the branch:
+        Newton from the last solution on it converges, without a jump, to a solution with the same
+        orientation sign(det dR/dq) (the branch turned back past a fold has the other)."""
+        eq = self.eq
+
+        def on_branch(t, q0, x0, sign):
+            s_, g_ = self.from_xy(c + t * n)
+            self.evaluations += 1
+            q = eq.solve(s_ * self.wref, g_, q0, follow=True)
+            if q is None or float(np.linalg.norm(q - q0)) > 50.0 * self._rate * float(np.linalg.norm(c + t * n - x0)):
+                return None
+            return q if eq.orientation(q, s_ * self.wref, g_) == sign else None
+
+        sign = eq.orientation(ra.q, ra.omega, ra.g0)
+        q_lo = on_branch(-d, ra.q, self._xy(ra), sign)
+        if q_lo is None or on_branch(d, q_lo, c - d * n, sign) is not None:
+            return None  # not on the branch before the bracket, or the branch goes on through it
+        lo, hi = -d, d
+        while hi - lo > 1e-6:
+            mid = 0.5 * (lo + hi)
+            q = on_branch(mid, q_lo, c + lo * n, sign)
+            if q is not None:
+                lo, q_lo = mid, q
+            else:
+                hi = mid
+        left = self.sample(c + lo * n, q_lo, ra)
+        if left is None or left.unstable:
+            return None
+        right = None
+        if rb is not None:
+            right = self.sample(c + (hi + 0.05) * n, rb.q, rb)
+            if right is None or not right.unstable:
+                return None
+        self._note_rate(ra.q, self._xy(ra), left.q, self._xy(left))
+        return c + 0.5 * (lo + hi) * n, "fold", left, right
+
+    def _fast_hopf(self, c: np.ndarray, n: np.ndarray, ra: Sample):
+        ref, t, slope = ra, 0.0, self._re_slope
+        pts: list[tuple[float, float, Sample]] = []
+        for _ in range(8):
+            x = c + t * n
+            smp = self.sample(x, ref.q, ref)
+            if smp is None or not self._continues(ref.q, self._xy(ref), smp.q, x):
+                return None
+            f = smp.mu.real
+            if smp.unstable and f <= RE_TOL:  # another mode leads
+                return None
+            pts.append((t, f, smp))
+            if abs(f) <= 1e-8:
+                break
+            if len(pts) >= 2:
+                slope = (f - pts[-2][1]) / (t - pts[-2][0])
+            if not slope > 0:
+                return None
+            t, ref = t - f / slope, smp
+            if abs(t) > 0.5:
+                return None
+        else:
+            return None
+        if len(pts) >= 2:
+            self._re_slope = slope
+        final = pts[-1][2]
+        stable = next((s for _, f, s in reversed(pts) if f < 0), final)
+        unstable = next((s for _, f, s in reversed(pts) if f > 0), final)
+        self._note_rate(ra.q, self._xy(ra), final.q, c + t * n)
+        return c + t * n, "hopf", stable, unstable
+
+    def _fast_event(self, c: np.ndarray, n: np.ndarray, ra: Sample, rb: Sample | None):
+        k = ra.event
+        sign = 1.0 if ra.contact_set[k] else -1.0  # signed gap: < 0 on the stable side
+
+        def solve(t, q0):
+            s_, g_ = self.from_xy(c + t * n)
+            self.evaluations += 1
+            q = self.eq.solve(s_ * self.wref, g_, q0, follow=True)
+            return q, (None if q is None else sign * float(self.eq.gaps(q, g_).ravel()[k]))
+
+        # on this branch the contact set is the stable side's, or that with point k toggled past the
+        # event (a switch). The 2D law is piecewise linear (friction saturated at these sliding
+        # speeds): one contact set, one solution, so another set is a jump to another branch
+        sets = {ra.contact_set, ra.contact_set[:k] + (not ra.contact_set[k],) + ra.contact_set[k + 1:]}
+
+        def on_branch(q, t):
+            return q is not None and self.eq.contact_set(q, self.from_xy(c + t * n)[1]) in sets
+
+        sides: dict[str, list[tuple[float, float, np.ndarray]]] = {"a": [], "b": []}
+        lo, hi = -0.5, 0.5
+        q_ref, t = ra.q, 0.0
+        for _ in range(10):
+            q, f = solve(t, q_ref)
+            if not on_branch(q, t):
+                return None
+            side = "a" if f < 0 else "b"
+            sides[side].append((t, f, q))
+            lo, hi = (max(lo, t), hi) if side == "a" else (lo, min(hi, t))
+            same = sides[side]
+            if len(same) >= 2 and same[-1][0] != same[-2][0]:
+                slope = (same[-1][1] - same[-2][1]) / (same[-1][0] - same[-2][0])
+            elif side in self._gap_slope:
+                slope = self._gap_slope[side]
+            else:  # a secant on this side: one more solution a thousandth of a cell inwards
+                dt = -1e-3 if side == "a" else 1e-3
+                q2, f2 = solve(t + dt, q)
+                if q2 is None:
+                    return None
+                slope = (f2 - f) / dt
+            if not slope > 0:
+                return None
+            self._gap_slope[side] = slope
+            step = -f / slope
+            q_ref = q
+            if abs(step) <= 1e-7:
+                t = t + step
+                break
+            t_new = t + step
+            if abs(t_new) > 0.5:
+                return None  # the event is not near: not this curve
+            if not lo < t_new < hi:
+                t_new = 0.5 * (lo + hi)
+            t = t_new
+        else:
+            return None
+        eps = 1e-6  # cells either side of the event, ten times its location error
+        near_a = min(sides["a"], key=lambda e: abs(e[0] - t))[2] if sides["a"] else q_ref
+        left = self.sample(c + (t - eps) * n, near_a, ra)
+        if left is None or left.unstable:
+            return None
+        right = self.sample(c + (t + eps) * n, left.q, rb)
+        if right is None or not right.unstable or right.contact_set[k] == left.contact_set[k]:
+            return None
+        right.event = k
+        left.event = k
+        self._note_rate(ra.q, self._xy(ra), left.q, self._xy(left))
+        return c + t * n, "switch", left, right
+
     def trace(self, a: np.ndarray, b: np.ndarray, sa: Sample, sb: Sample, max_points: int = 4000) -> Curve | None:
         """The curve through the boundary point between a (stable) and b (unstable), both ways."""
         self._rate = None
+        self._re_slope = None
+        self._gap_slope = {}
         first = self.locate(a, b, sa, sb)  # across a lattice edge: no continuity guard yet
         if first is None:
             return None
@@ -242,7 +434,7 @@ class BoundaryTracer:
                     c = _clip_to_box(p, c, self)
                     if c is None or np.linalg.norm(c - p) < 1e-6:
                         break
-                got = self._bracket(c, n, ref, h)
+                got = self._fast(c, n, pts[-1][1], ref) or self._bracket(c, n, ref, h)
                 if got is None:
                     h *= 0.5
                     if h >= 0.05 * self.h_max:
@@ -254,9 +446,9 @@ class BoundaryTracer:
                     h = self.h_max
                 pn, kind, ra, rb = got
                 if len(pts) % 10 == 0:  # every tenth point: whole spectra, so that no other mode is missed
-                    ra = self.sample(self.to_xy(ra.omega / self.wref, ra.g0), ra.q) or ra
+                    ra = self._resample(ra)
                     if rb is not None:
-                        rb = self.sample(self.to_xy(rb.omega / self.wref, rb.g0), rb.q) or rb
+                        rb = self._resample(rb)
                 smp = rb if rb is not None else ra
                 step = pn - p
                 if np.linalg.norm(step) < 1e-9:
@@ -293,6 +485,14 @@ class BoundaryTracer:
             cv.normals.append((float(n[0]), float(n[1])))
         return cv
 
+    def _resample(self, smp: Sample) -> Sample:
+        """The sample again with the whole spectrum (its event kept)."""
+        full = self.sample(self._xy(smp), smp.q)
+        if full is None:
+            return smp
+        full.event = smp.event
+        return full
+
     def _corner(self, p: np.ndarray, tau: np.ndarray, ref: tuple[Sample, Sample | None]):
         """On a ring of radius h_max round p, the first verdict change ahead (within 150 degrees of
         tau), located between the two ring points that disagree."""
@@ -325,9 +525,9 @@ class BoundaryTracer:
             sb = self.sample(b, None if ref[1] is None else ref[1].q, ref[1])
             if sb is None and not sa.unstable:
                 # no equilibrium on the far side: the stable branch ends between (a fold)
-                tj = self._jump(a, b, sa)
-                if tj is not None:
-                    return a + tj * (b - a), "fold", sa, None
+                jump = self._jump(a, b, sa)
+                if jump is not None:
+                    return a + jump * (b - a), "fold", sa, None
                 continue
             if sb is None:
                 continue

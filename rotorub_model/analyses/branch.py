@@ -222,10 +222,10 @@ def _locate(tr: _Tracer, ya: np.ndarray, yb: np.ndarray, pa: Point, pb: Point, t
             if y is None:
                 return None
             q, p = tr.unpack(y)
-            return float(tr.eq.contact(tr.args(p)[1]).gaps(q).ravel()[k])
+            return float(tr.eq.gaps(q, tr.args(p)[1]).ravel()[k])
 
-        ga = float(tr.eq.contact(pa.g0).gaps(pa.q).ravel()[k])
-        gb = float(tr.eq.contact(pb.g0).gaps(pb.q).ravel()[k])
+        ga = float(tr.eq.gaps(pa.q, pa.g0).ravel()[k])
+        gb = float(tr.eq.gaps(pb.q, pb.g0).ravel()[k])
         if ga * gb < 0:
             s_event = illinois(gap, ga, gb, 1e-9, f_tol=1e-15, retry_midpoint=True)
         if s_event is not None:

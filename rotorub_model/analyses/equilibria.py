@@ -55,6 +55,9 @@ class Equilibria:
         self.base = make_contact(model, formulation, variant)
         self.me = model.params.imbalance.me if me is None else me
         self.tol = tol
+        # a continuation step starts next to the solution: Newton converges in 1-3 iterations (up to ~8
+        # near a fold); one that has not in 10 has lost the branch, and a lost one is what costs
+        self.follow_iterations = 10
         self.n = model.n_dofs
         self._contacts: dict[float, ContactModel] = {}
         self._Minv = np.linalg.inv(model.M)
@@ -64,6 +67,18 @@ class Equilibria:
         self._rel, self._its = ctypes.c_double(), ctypes.c_int()
         self._swork = np.empty(self.base.lib.rr_static_work_size(self.n))
         self._iwork = np.empty(self.n, dtype=np.intc)
+        self._wptr = (kernel.ptr(self._swork), kernel.iptr(self._iwork))
+        # one contact model whose clearance is set in place, for the solver's and the spectra's own use:
+        # a continuation visits a new g0 at nearly every call, and building a model per g0 (its kernel
+        # view, its work array) cost as much as the Newton solve itself
+        self._scratch = self.base.with_clearance(float(self.base.g0))
+
+    def _law(self, g0: float) -> ContactModel:
+        c = self._scratch
+        if c.g0 != g0:
+            c.g0 = float(g0)
+            c.kernel.g0 = float(g0)
+        return c
 
     # ------------------------------------------------------------------ pieces
     def contact(self, g0: float) -> ContactModel:
@@ -75,11 +90,17 @@ class Equilibria:
         return c
 
     def residual(self, q: np.ndarray, omega: float, g0: float) -> np.ndarray:
-        return self.model.K_omega(omega) @ q - self.contact(g0).forces(q, omega) - self.model.force(omega, self.me)
+        return self.model.K_omega(omega) @ q - self._law(g0).forces(q, omega) - self.model.force(omega, self.me)
 
     def jacobian(self, q: np.ndarray, omega: float, g0: float) -> np.ndarray:
         """dR/dq = K(Omega) - dF_nl/dq."""
-        return self.model.K_omega(omega) - self.contact(g0).jacobian(q, omega)
+        return self.model.K_omega(omega) - self._law(g0).jacobian(q, omega)
+
+    def orientation(self, q: np.ndarray, omega: float, g0: float) -> float:
+        """sign(det dR/dq): it changes across a fold, so it tells the two branches meeting there apart
+        (in 2D too, where the piecewise-linear branch turns at a contact event)."""
+        self._at_speed(omega)
+        return float(np.linalg.slogdet(self._speed_cache[1] - self._law(g0).jacobian(q, omega))[0])
 
     def d_param(self, q: np.ndarray, omega: float, g0: float, which: str) -> np.ndarray:
         """dR/d(parameter) by central differences (the laws are C^1 in 3D, and piecewise linear in
@@ -90,42 +111,48 @@ class Equilibria:
         h = 1e-7 * max(abs(omega), 1.0)
         return (self.residual(q, omega + h, g0) - self.residual(q, omega - h, g0)) / (2 * h)
 
-    def _at_speed(self, omega: float) -> tuple[np.ndarray, np.ndarray]:
+    def _at_speed(self, omega: float) -> tuple[int, int]:
+        """Addresses of K(Omega) and the imbalance load at Omega (kept while the speed is unchanged)."""
         hit = self._speed_cache
         if hit is None or hit[0] != omega:
             K = np.ascontiguousarray(self.model.K_omega(omega), dtype=float)
             F = np.ascontiguousarray(self.model.force(omega, self.me), dtype=float)
-            hit = self._speed_cache = (omega, K, F)
-        return hit[1], hit[2]
+            hit = self._speed_cache = (omega, K, F, kernel.ptr(K), kernel.ptr(F))
+        return hit[3], hit[4]
 
-    def solve(self, omega: float, g0: float, q0: np.ndarray | None = None, follow: bool = False) -> np.ndarray | None:
+    def solve(self, omega: float, g0: float, q0: np.ndarray | None = None, follow: bool = False,
+              max_iter: int | None = None) -> np.ndarray | None:
         """The balanced solution from the warm start q0 (None if it does not converge): the kernel's
         solver, as in :func:`.static.solve_static`, with the speed's matrices kept between calls.
-        ``follow``: Newton from q0 only (a continuation step: no other start, no jump to another branch)."""
+        ``follow``: Newton from q0 only (a continuation step: no other start, no jump to another branch),
+        at most ``max_iter`` iterations (``follow_iterations`` by default)."""
         if not (np.isfinite(omega) and omega >= 0):
             return solve_static(self.model, self.contact(g0), omega).q  # raises the parameter error
         K, F = self._at_speed(omega)
-        c = self.contact(g0)
+        c = self._law(g0)
         k, lib = c.kernel, c.lib
         if follow and q0 is not None:
             q = np.array(q0, dtype=float)
-            ok = lib.rr_static_newton(k, float(omega), kernel.ptr(K), kernel.ptr(F), float(self.tol), 30,
-                                      kernel.ptr(q), ctypes.byref(self._rel), ctypes.byref(self._its),
-                                      kernel.ptr(self._swork), kernel.iptr(self._iwork))
+            its = max_iter or self.follow_iterations
+            ok = lib.rr_static_newton(k, float(omega), K, F, float(self.tol), its, q.ctypes.data,
+                                      ctypes.byref(self._rel), ctypes.byref(self._its), *self._wptr)
             return q if ok else None
         q = np.empty(self.n)
         start = None if q0 is None else np.ascontiguousarray(q0, dtype=float)
-        ok = lib.rr_static_solve(k, float(omega), kernel.ptr(K), kernel.ptr(F),
-                                 None if start is None else kernel.ptr(start), float(self.tol), 60, kernel.ptr(q),
-                                 ctypes.byref(self._rel), ctypes.byref(self._its), kernel.ptr(self._swork),
-                                 kernel.iptr(self._iwork))
+        ok = lib.rr_static_solve(k, float(omega), K, F, None if start is None else kernel.ptr(start),
+                                 float(self.tol), 60, q.ctypes.data, ctypes.byref(self._rel),
+                                 ctypes.byref(self._its), *self._wptr)
         return q if ok else None
 
     def contact_set(self, q: np.ndarray, g0: float) -> tuple:
-        return tuple(bool(x) for x in (self.contact(g0).gaps(q) < 0.0).ravel())
+        return tuple(bool(x) for x in (self._law(g0).gaps(q) < 0.0).ravel())
+
+    def gaps(self, q: np.ndarray, g0: float) -> np.ndarray:
+        """Gaps (N, P) [m] of the balanced solution q at clearance g0."""
+        return self._law(g0).gaps(q)
 
     def point(self, q: np.ndarray, omega: float, g0: float, spectrum: bool = True) -> Point:
-        gaps, laws = self.contact(g0)._eval(q)  # one evaluation of the law for both
+        gaps, laws = self._law(g0)._eval(q)  # one evaluation of the law for both
         p = Point(float(omega), float(g0), q, tuple(bool(x) for x in (gaps < 0.0).ravel()),
                   int(np.sum(laws[:, 0] > 0)), float(laws[:, 0].max()), float(np.hypot(*(self._T2 @ q))))
         if spectrum:
@@ -143,7 +170,7 @@ class Equilibria:
     # ------------------------------------------------------------------ linearisation
     def linearisation(self, q: np.ndarray, omega: float, g0: float) -> tuple[np.ndarray, np.ndarray]:
         """(K_e, C_e) of the perturbation equation at the balanced solution q."""
-        J, Jv = self.contact(g0).jacobians(q, omega)
+        J, Jv = self._law(g0).jacobians(q, omega)
         m = self.model
         return m.K_omega(omega) - J, m.D + m.G(omega) - Jv
 
