@@ -80,6 +80,7 @@ class BoundaryTracer:
         # eigenvalue can be followed through them; the 2D point law's stiffness jumps there
         self.continuous = eq.formulation == "3D"
         self._by_set: dict[tuple, Sample] = {}
+        self._exact: dict[tuple, tuple] = {}  # 2D: (contact set, Omega) -> (mu, max real, v, whole spectrum?)
         self._re_slope: float | None = None  # d Re(mu) / d(offset along the normal) at the last Hopf point [1/s/cell]
         self._gap_slope: dict[str, float] = {}  # d(signed gap) / d(offset), each side of the last event
 
@@ -114,6 +115,12 @@ class BoundaryTracer:
         if q is None:
             return None
         cset = self.eq.contact_set(q, g)
+        if not self.continuous:
+            # 2D: the linearisation is a function of the contact set and the speed alone (the point
+            # law is piecewise linear, friction saturated), so is the spectrum: computed once per pair
+            hit = self._exact.get((cset, w))
+            if hit is not None and (previous is not None or hit[3]):
+                return Sample(w, g, q, cset, hit[0], hit[1], hit[2])
         if previous is not None and not (cset == previous.contact_set or self.continuous):
             # 2D: the linearisation depends on the contact set (and the speed) only, so the last
             # sample seen with this set is as good a start as a neighbour
@@ -124,15 +131,19 @@ class BoundaryTracer:
                 others = previous.max_real if previous.max_real > previous.mu.real + 1e-9 else -math.inf
                 smp = Sample(w, g, q, cset, mu, max(mu.real, others), v)
                 self._by_set[cset] = smp
+                if not self.continuous:
+                    self._exact.setdefault((cset, w), (mu, smp.max_real, v, False))
                 return smp
         mu, mr = self.eq.critical(q, w, g)
         self.full_spectra += 1
         smp = self._by_set[cset] = Sample(w, g, q, cset, mu, mr)
+        if not self.continuous:
+            self._exact[(cset, w)] = (mu, mr, None, True)
         return smp
 
     def _jump(self, a: np.ndarray, b: np.ndarray, sa: Sample, n_sub: int = 6) -> float | None:
         """Where the balanced solution continued from a towards b jumps to another branch (a fold of
-        the branch the maps follow), to 1e-6 of the segment; None if it is continuous."""
+        the branch the maps follow), to 1e-6 of a cell; None if it is continuous."""
         ts = np.linspace(0.0, 1.0, n_sub + 1)
         qs = [sa.q]
         for t in ts[1:]:
@@ -158,7 +169,8 @@ class BoundaryTracer:
         # 2D: from a start this close, Newton on the piecewise-linear law converges in one to three
         # iterations or has lost the branch (a lost one would otherwise spend ten on line searches)
         its = None if self.continuous else 4
-        while hi - lo > 1e-6:
+        tol = 1e-6 / float(np.linalg.norm(b - a))  # 1e-6 of a cell, as the other kinds
+        while hi - lo > tol:
             mid = 0.5 * (lo + hi)
             s_, g_ = self.from_xy(a + mid * (b - a))
             q = self.eq.solve(s_ * self.wref, g_, q_lo, follow=True, max_iter=its)
@@ -404,12 +416,18 @@ class BoundaryTracer:
         self._note_rate(ra.q, self._xy(ra), left.q, self._xy(left))
         return c + t * n, "switch", left, right
 
-    def trace(self, a: np.ndarray, b: np.ndarray, sa: Sample, sb: Sample, max_points: int = 4000) -> Curve | None:
-        """The curve through the boundary point between a (stable) and b (unstable), both ways."""
+    def trace(self, a: np.ndarray, b: np.ndarray, sa: Sample, sb: Sample | None,
+              max_points: int = 4000) -> Curve | None:
+        """The curve through the boundary point between a (stable) and b (unstable, or no balanced
+        solution there: the stable branch ends in between), both ways."""
         self._rate = None
         self._re_slope = None
         self._gap_slope = {}
-        first = self.locate(a, b, sa, sb)  # across a lattice edge: no continuity guard yet
+        if sb is None:
+            jump = self._jump(a, b, sa)
+            first = None if jump is None else (a + jump * (b - a), "fold", sa, None)
+        else:
+            first = self.locate(a, b, sa, sb)  # across a lattice edge: no continuity guard yet
         if first is None:
             return None
         self.tracking = True
@@ -423,7 +441,7 @@ class BoundaryTracer:
         n0 = (b - a) / np.linalg.norm(b - a)
         halves = []
         for direction in (1.0, -1.0):
-            pts = [(p0, kind0, r0b, n0)]
+            pts = [(p0, kind0, r0b if r0b is not None else r0a, n0)]
             p, n, ref = p0, n0, (r0a, r0b)
             tau = direction * np.array([-n[1], n[0]])
             h = self.h_max
@@ -456,7 +474,11 @@ class BoundaryTracer:
                     continue
                 t_new = step / np.linalg.norm(step)
                 n_new = np.array([t_new[1], -t_new[0]]) * direction
-                if n_new @ n < 0:
+                # the normal points to the unstable side: away from the stable sample the corrector
+                # returned (after a corner the curve may turn by more than 90 degrees, so the last
+                # normal cannot orient it), else as the last normal
+                away = pn - self._xy(ra)
+                if (n_new @ away < 0) if np.linalg.norm(away) > 1e-9 else (n_new @ n < 0):
                     n_new = -n_new
                 pts.append((pn, kind, smp, n_new))
                 p, n, tau, ref = pn, n_new, t_new, (ra, rb)
@@ -505,9 +527,17 @@ class BoundaryTracer:
         order = np.argsort(np.abs(angles - ang0))  # nearest to straight ahead first
         for k in order:
             for j in (k - 1, k + 1):
-                if not (0 <= j < len(ring)) or samples[k] is None or samples[j] is None:
+                if not (0 <= j < len(ring)) or samples[k] is None:
                     continue
                 sk, sj = samples[k], samples[j]
+                if sj is None and self.inside(ring[j]) and not sk.unstable:
+                    # no solution on the followed branch there: it ends in between (a fold)
+                    jump = self._jump(ring[k], ring[j], sk)
+                    if jump is not None:
+                        return ring[k] + jump * (ring[j] - ring[k]), "fold", sk, None
+                    continue
+                if sj is None:
+                    continue
                 if sk.unstable == sj.unstable:
                     continue
                 a, b, sa, sb = (ring[k], ring[j], sk, sj) if not sk.unstable else (ring[j], ring[k], sj, sk)
@@ -581,7 +611,7 @@ def _segments_intersect(a, b, c, d) -> bool:
 
 
 def trace_boundaries(eq: Equilibria, speeds: np.ndarray, g0s: np.ndarray, resolution: float = 0.1,
-                     lattice: tuple[int, int] = (9, 9)) -> tuple[list[Curve], dict]:
+                     lattice: tuple[int, int] = (17, 17)) -> tuple[list[Curve], dict]:
     """Every stability-boundary curve inside the range of the map grid (normalised ``speeds`` x
     ``g0s`` [m]), points at most ``resolution`` cells apart."""
     cs = (speeds[-1] - speeds[0]) / max(len(speeds) - 1, 1)
@@ -600,14 +630,19 @@ def trace_boundaries(eq: Equilibria, speeds: np.ndarray, g0s: np.ndarray, resolu
     curves: list[Curve] = []
     edges = [((i, j), (i, j + 1)) for i in range(len(ls)) for j in range(len(lg) - 1)]
     edges += [((i, j), (i + 1, j)) for i in range(len(ls) - 1) for j in range(len(lg))]
+    def verdict(smp: Sample | None) -> str:
+        return "none" if smp is None else "unstable" if smp.unstable else "stable"
+
     for e0, e1 in edges:
         s0, s1 = grid[e0], grid[e1]
-        if s0 is None or s1 is None or s0.unstable == s1.unstable:
+        v0, v1 = verdict(s0), verdict(s1)
+        # a seed: a stable end and an unstable one, or a stable end and none (the branch ends between)
+        if v0 == v1 or "stable" not in (v0, v1):
             continue
         a, b = tr.to_xy(ls[e0[0]], lg[e0[1]]), tr.to_xy(ls[e1[0]], lg[e1[1]])
         if any(crosses(c, tr, a, b) or near(c, tr, a, b) for c in curves):
             continue
-        if s0.unstable:
+        if v0 != "stable":
             a, b, s0, s1 = b, a, s1, s0
         cv = tr.trace(a, b, s0, s1)
         if cv is not None and len(cv) > 1:
