@@ -101,7 +101,9 @@ class BoundaryTracer:
         starts would land on another branch, which the maps do not follow either)."""
         self.evaluations += 1
         if q0 is not None:  # Newton from the neighbour first: cheap, and it stays on the branch
-            q = self.eq.solve(w, g, q0, follow=True)
+            # (30 iterations: the neighbour may be a bracket's width away, across contact events, and
+            # the solver below would start from it again with its own other starts behind)
+            q = self.eq.solve(w, g, q0, follow=True, max_iter=30)
             if q is not None:
                 return q
         return self.eq.solve(w, g, q0)  # then the solver's other starts, as the maps do
@@ -279,33 +281,73 @@ class BoundaryTracer:
             return self._fast_fold(c, n, ra, rb)
         return None
 
-    def _fast_fold(self, c: np.ndarray, n: np.ndarray, ra: Sample, rb: Sample | None, d: float = 0.02):
-        """The end of the followed branch on the normal line through c, bisected from a bracket of
-        +-d cells (the last fold point's continuation puts it near c) to 1e-6 cells. On the branch:
-        Newton from the last solution on it converges, without a jump, to a solution with the same
-        orientation sign(det dR/dq) (the branch turned back past a fold has the other)."""
-        eq = self.eq
+    def branch_end(self, c: np.ndarray, n: np.ndarray, q0: np.ndarray, x0: np.ndarray,
+                   d: float = 0.02) -> tuple[float, float, np.ndarray] | None:
+        """Where the branch through q0 (at x0, scaled coordinates) ends on the line c + t n, |t| < d:
+        (last offset on it, first offset off it, the solution at the last), 1e-6 cells apart; None if
+        it does not end there. 3D, a smooth fold.
 
-        def on_branch(t, q0, x0, sign):
+        On the branch: Newton from the last solution on it converges, without a jump, to a solution
+        of the same orientation sign(det dR/dq) (the branch turned back past the fold has the other).
+        Approaching the fold, the offset is t_f - a s^2 - b s^3 + O(s^4) in s = |det| (relative):
+        fitted through the last three solutions on the branch (a secant in s^2 with two), it predicts
+        t_f; each round tries just short of and just past the prediction, and the bracket [last on the
+        branch, first off it] closes in a few rounds (bisection when the prediction falls outside it)."""
+        eq = self.eq
+        s0, g0 = self.from_xy(x0)
+        sign, ld0 = eq.orientation(q0, s0 * self.wref, g0)
+
+        def on_branch(t, q_from, x_from):
             s_, g_ = self.from_xy(c + t * n)
             self.evaluations += 1
-            q = eq.solve(s_ * self.wref, g_, q0, follow=True)
-            if q is None or float(np.linalg.norm(q - q0)) > 50.0 * self._rate * float(np.linalg.norm(c + t * n - x0)):
-                return None
-            return q if eq.orientation(q, s_ * self.wref, g_) == sign else None
+            q = eq.solve(s_ * self.wref, g_, q_from, follow=True)
+            if q is None or float(np.linalg.norm(q - q_from)) > 50.0 * self._rate * float(
+                    np.linalg.norm(c + t * n - x_from)):
+                return None, 0.0
+            sg, ld = eq.orientation(q, s_ * self.wref, g_)
+            return (q, math.exp(ld - ld0)) if sg == sign else (None, 0.0)
 
-        sign = eq.orientation(ra.q, ra.omega, ra.g0)
-        q_lo = on_branch(-d, ra.q, self._xy(ra), sign)
-        if q_lo is None or on_branch(d, q_lo, c - d * n, sign) is not None:
+        q_lo, r_lo = on_branch(-d, q0, x0)
+        if q_lo is None or on_branch(d, q_lo, c - d * n)[0] is not None:
             return None  # not on the branch before the bracket, or the branch goes on through it
         lo, hi = -d, d
-        while hi - lo > 1e-6:
-            mid = 0.5 * (lo + hi)
-            q = on_branch(mid, q_lo, c + lo * n, sign)
-            if q is not None:
-                lo, q_lo = mid, q
-            else:
-                hi = mid
+        pts = [(lo, r_lo)]  # (offset, |det| relative) on the branch
+        for _ in range(40):
+            if hi - lo <= 1e-6:
+                return lo, hi, q_lo
+            t_root = 0.5 * (lo + hi)
+            fit: list[tuple[float, float]] = []
+            for t, r in reversed(pts):  # the last three, at least 1e-6 cells apart
+                if all(abs(t - u) > 1e-6 for u, _ in fit):
+                    fit.append((t, r))
+                if len(fit) == 3:
+                    break
+            if len(fit) >= 2:
+                A = np.array([[1.0, r * r, r ** 3][:len(fit)] for _, r in fit])
+                try:
+                    guess = float(np.linalg.solve(A, np.array([t for t, _ in fit]))[0])
+                except np.linalg.LinAlgError:
+                    guess = t_root
+                if lo < guess < hi:
+                    t_root = guess
+            for t in (t_root - 4e-7, t_root + 4e-7) if len(pts) >= 2 else (t_root,):
+                if not lo < t < hi:
+                    continue
+                q, r = on_branch(t, q_lo, c + lo * n)
+                if q is not None:
+                    lo, q_lo = t, q
+                    pts.append((t, r))
+                else:
+                    hi = t
+        return None
+
+    def _fast_fold(self, c: np.ndarray, n: np.ndarray, ra: Sample, rb: Sample | None):
+        """A point of a 3D fold curve on the normal line through c: the branch's end, stable before it
+        (and unstable beyond, where the maps land)."""
+        end = self.branch_end(c, n, ra.q, self._xy(ra))
+        if end is None:
+            return None
+        lo, hi, q_lo = end
         left = self.sample(c + lo * n, q_lo, ra)
         if left is None or left.unstable:
             return None

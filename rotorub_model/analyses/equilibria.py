@@ -96,11 +96,12 @@ class Equilibria:
         """dR/dq = K(Omega) - dF_nl/dq."""
         return self.model.K_omega(omega) - self._law(g0).jacobian(q, omega)
 
-    def orientation(self, q: np.ndarray, omega: float, g0: float) -> float:
-        """sign(det dR/dq): it changes across a fold, so it tells the two branches meeting there apart
-        (in 2D too, where the piecewise-linear branch turns at a contact event)."""
+    def orientation(self, q: np.ndarray, omega: float, g0: float) -> tuple[float, float]:
+        """(sign, log|det|) of dR/dq. The sign changes across a fold, so it tells the two branches
+        meeting there apart; approaching a smooth fold det^2 vanishes linearly in the parameter."""
         self._at_speed(omega)
-        return float(np.linalg.slogdet(self._speed_cache[1] - self._law(g0).jacobian(q, omega))[0])
+        sign, logdet = np.linalg.slogdet(self._speed_cache[1] - self._law(g0).jacobian(q, omega))
+        return float(sign), float(logdet)
 
     def d_param(self, q: np.ndarray, omega: float, g0: float, which: str) -> np.ndarray:
         """dR/d(parameter) by central differences (the laws are C^1 in 3D, and piecewise linear in
