@@ -148,7 +148,7 @@ def test_transient_settles_on_the_predicted_orbit(model, w33):
 def test_boundary_curves_agree_with_the_quick_grid_map(model, formulation):
     """Over the main job's quick map (40 x 36 cells round the first critical): every grid cell that
     contradicts the side of the traced curves lies within one cell of them (measured: 2D none at all,
-    3D 3 cells, each within one cell). The curves include the folds where the maps' branch jumps."""
+    3D 2 cells, each within one cell). The curves include the folds where the maps' branch jumps."""
     from rotorub_model.app.studies import default_grid
 
     speeds, g0s = default_grid(model, quick=True)

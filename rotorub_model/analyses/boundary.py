@@ -1,25 +1,40 @@
 """The stability boundary of the balanced solutions in the (Omega, g0) plane, traced as curves.
 
-A point of the boundary separates a stable balanced solution from an unstable one. Two kinds
-occur, and one tracker follows both:
+A point of the boundary separates a stable balanced solution from an unstable one. Three kinds
+occur, and one tracker follows them all:
 
 * **Hopf curves**: the critical eigenvalue's real part crosses zero within one contact set
-  (located by regula falsi on Re mu to |Re mu| <= 1e-8 /s);
+  (located to |Re mu| <= 1e-8 /s);
 * **switch curves**: the stability changes where a contact point's gap crosses zero (2D: a blade
   entering contact makes the point law's stiffness jump, and the eigenvalues with it), located
-  on the gap.
+  on the gap;
+* **fold curves**: the branch the maps follow ends (Newton from the neighbour loses it, or it
+  jumps to another branch), and the verdict changes with the branch the maps land on, or there is
+  no balanced solution left.
 
-Two-parameter continuation by bracketing: in coordinates scaled by the map's cell size, a curve
-point P with unit normal n (pointing to the unstable side) and tangent tau is continued by the
-predictor C = P + h tau; the corrector brackets the boundary on the normal line through C (a
-stable point C - d n, an unstable one C + d n) and locates the crossing there. Step h: at most
-``resolution`` cells (a tenth of a cell by default), halved where the bracket fails (a corner,
-where a Hopf curve meets a switch curve). Balanced solutions are warm-started from the nearest
-curve point, so the tracker stays on the branch the maps follow (descending g0).
+Two-parameter continuation in coordinates scaled by the map's cell size: a curve point P with
+unit normal n (pointing to the unstable side) and tangent tau is continued by the predictor
+C = P + h tau, and the corrector finds the curve on the normal line through C. Step h: at most
+``resolution`` cells (a tenth of a cell by default), halved where the corrector fails; at a corner
+(a Hopf curve meeting a switch or fold curve) the tracer looks round the last point on a ring.
+Balanced solutions are continued from the nearest curve point, so the tracker stays on the branch
+the maps follow (descending g0).
 
-Seeds: the verdicts on a coarse lattice (each speed swept from the largest clearance down, as
-the grid maps are); every lattice edge whose ends disagree and that no traced curve crosses yet
-starts a curve, traced both ways until it leaves the range, closes, or stops.
+Two correctors. The **fast** one knows the kind of curve (and for a switch the contact point)
+from the last point and solves for the offset along the normal by Newton/secant on what vanishes
+there: Re mu (Hopf), the point's gap (2D switch; the law is piecewise linear, so each side of the
+event is a straight line), or the branch's end (3D fold: det^2 of dR/dq vanishes linearly). It
+then checks that it has the boundary (the verdicts either side, no jump to another branch) and
+otherwise returns nothing. The **bracketing** one, behind it, finds a stable point C - d n and an
+unstable one C + d n and locates the crossing between them (regula falsi, the gap's root, or the
+branch's end by bisection); it starts every curve and takes over at corners. A Hopf or switch
+point costs the fast corrector three to five balanced solutions, a fold point about ten; the
+bracketing one takes ten to thirty.
+
+Seeds: the verdicts on a 17 x 17 lattice (each speed swept from the largest clearance down, as
+the grid maps are); every lattice edge from a stable end to an unstable one (or to none: no
+balanced solution there) that no traced curve crosses yet starts a curve, traced both ways until
+it leaves the range, closes, or stops.
 """
 
 from __future__ import annotations
