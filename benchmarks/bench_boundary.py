@@ -42,7 +42,9 @@ def main(argv: list[str] | None = None) -> int:
     print(f"ratio curves / grid: {t_curves / t_grid:.2f} (target < 1)")
     for f, (cv, info) in curves.items():
         a = agreement(cv, maps[f], tuple(info["cell"]))
-        print(f"  {f}: {len(cv)} curves, {sum(len(c) for c in cv)} points, {info['evaluations']} equilibria; "
+        by = info["points_by_corrector"]
+        print(f"  {f}: {len(cv)} curves, {sum(len(c) for c in cv)} points ({by['fast']} by the fast corrector, "
+              f"{by['bracket']} by the bracketing one), {info['evaluations']} equilibria; "
               f"grid cells contradicting them: {a['contradicting_cells']} of {a['grid_cells']} "
               f"({a['contradicting_beyond_one_cell']} beyond one cell)")
     return 0

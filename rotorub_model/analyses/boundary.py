@@ -88,8 +88,8 @@ class BoundaryTracer:
         self.cs, self.cg = cell  # cell size in speed (normalised) and in g0 [m]
         self.h_max = resolution
         self.evaluations = 0
+        self.by_corrector = {"fast": 0, "bracket": 0}  # curve points each corrector found
         self.full_spectra = 0
-        self.tracking = False
         self._rate: float | None = None  # |dq| per cell across the last brackets
         # the 3D chord law is C^1: the spectrum is continuous across contact events and the critical
         # eigenvalue can be followed through them; the 2D point law's stiffness jumps there
@@ -487,11 +487,7 @@ class BoundaryTracer:
             first = self.locate(a, b, sa, sb)  # across a lattice edge: no continuity guard yet
         if first is None:
             return None
-        self.tracking = True
-        try:
-            return self._trace(a, b, first, max_points)
-        finally:
-            self.tracking = False
+        return self._trace(a, b, first, max_points)
 
     def _trace(self, a, b, first, max_points):
         p0, kind0, r0a, r0b = first
@@ -509,7 +505,12 @@ class BoundaryTracer:
                     c = _clip_to_box(p, c, self)
                     if c is None or np.linalg.norm(c - p) < 1e-6:
                         break
-                got = self._fast(c, n, pts[-1][1], ref) or self._bracket(c, n, ref, h)
+                got = self._fast(c, n, pts[-1][1], ref)
+                if got is not None:
+                    self.by_corrector["fast"] += 1
+                else:
+                    got = self._bracket(c, n, ref, h)
+                    self.by_corrector["bracket"] += got is not None
                 if got is None:
                     h *= 0.5
                     if h >= 0.05 * self.h_max:
@@ -705,4 +706,4 @@ def trace_boundaries(eq: Equilibria, speeds: np.ndarray, g0s: np.ndarray, resolu
         if cv is not None and len(cv) > 1:
             curves.append(cv)
     return curves, {"evaluations": tr.evaluations, "cell": [cs, cg], "resolution_cells": resolution,
-                    "lattice": list(lattice)}
+                    "lattice": list(lattice), "points_by_corrector": dict(tr.by_corrector)}
