@@ -277,7 +277,8 @@ def run_continuation(model: Model, maps: dict[str, StabilityMap] | None = None, 
             cv, info = trace_boundaries(eq, np.asarray(speeds), np.asarray(g0s))
             curves[f] = cv
             timings[f"boundary_{f}"] = time.perf_counter() - t0
-            agree[f] = {"evaluations": info["evaluations"], "resolution_cells": info["resolution_cells"]}
+            agree[f] = {"evaluations": info["evaluations"], "resolution_cells": info["resolution_cells"],
+                        "points_by_corrector": info["points_by_corrector"]}
             if maps and f in maps:
                 agree[f].update(agreement(cv, maps[f], tuple(info["cell"])))
     return ContinuationResult(speed, branches, orbits, curves, agree, timings, maps or {})
