@@ -375,6 +375,8 @@ class BoundaryTracer:
         return c + 0.5 * (lo + hi) * n, "fold", left, right
 
     def _fast_hopf(self, c: np.ndarray, n: np.ndarray, ra: Sample):
+        """A point of a Hopf curve on the normal line through c: secant on Re mu (the critical
+        eigenvalue followed from the last point), started with the last point's slope, to 1e-8 /s."""
         ref, t, slope = ra, 0.0, self._re_slope
         pts: list[tuple[float, float, Sample]] = []
         for _ in range(8):
@@ -406,6 +408,9 @@ class BoundaryTracer:
         return c + t * n, "hopf", stable, unstable
 
     def _fast_event(self, c: np.ndarray, n: np.ndarray, ra: Sample, rb: Sample | None):
+        """A point of a 2D switch curve on the normal line through c: where the gap of the last point's
+        contact point vanishes (Newton with each side's own slope: the gap is piecewise linear, with
+        its kink at the root), then the verdicts 1e-6 cells either side."""
         k = ra.event
         sign = 1.0 if ra.contact_set[k] else -1.0  # signed gap: < 0 on the stable side
 
