@@ -189,6 +189,25 @@ def test_boundary_curves_do_not_hang_on_the_seed_lattice(model, quick_maps, form
     assert a["contradicting_fraction"] < 0.01
 
 
+@pytest.mark.parametrize("formulation", ["2D", "3D"])
+def test_boundary_curves_agree_on_a_softer_contact(formulation):
+    """Another configuration (the tip's contact stiffness halved): the curves still leave no grid cell
+    contradicting them beyond one cell. 3D failed here before the tracer learnt to check a seed's or
+    a corner's stable side by its whole spectrum and to re-start a lost regula falsi iterate from the
+    stable end (152 cells beyond one cell; now 3, all within one)."""
+    from rotorub_model.app.studies import default_grid
+    from rotorub_model.structure.params import reference_parameters
+
+    m = build_model(reference_parameters().replace(contact={"k_r": 0.75e6}))
+    speeds, g0s = default_grid(m, quick=True)
+    mp = run_stability_map(m, formulation, speeds, g0s, executor="serial", progress=False)
+    curves, info = trace_boundaries(Equilibria(m, formulation), speeds, g0s)
+    a = agreement(curves, mp, tuple(info["cell"]))
+    assert a["regions"] >= 2
+    assert a["contradicting_beyond_one_cell"] == 0, a
+    assert a["contradicting_fraction"] < 0.01
+
+
 def test_transient_settles_on_the_orbit_born_at_the_hopf_point(hopf_3d, model, w33):
     """3D: the orbit predicted from the Hopf point alone (continued to g0 = 0.3323 mm, 1.5 um below
     it: 2.8 um peak-to-peak of the disk, stable) is where a transient started next to the unstable

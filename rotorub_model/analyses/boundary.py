@@ -31,6 +31,10 @@ branch's end by bisection); it starts every curve and takes over at corners. A H
 point costs the fast corrector three to five balanced solutions, a fold point about ten; the
 bracketing one takes ten to thirty.
 
+Where the leading mode or branch changes: a seed's stable side is checked by its whole spectrum
+(another mode may have crossed first), every tenth point's too, and in 3D every point's stable
+side must lie on the sheet of balanced solutions the curve was seeded on (same sign(det dR/dq)).
+
 Seeds: the verdicts on a 17 x 17 lattice (each speed swept from the largest clearance down, as
 the grid maps are); every lattice edge from a stable end to an unstable one (or to none: no
 balanced solution there) that no traced curve crosses yet starts a curve, traced both ways until
@@ -59,6 +63,7 @@ class Sample:
     max_real: float
     v: np.ndarray | None = None  # its eigenvector (warm start of the next refinement)
     event: int | None = None  # on a switch or fold curve: the contact point whose gap is zero there
+    orientation: float | None = None  # sign(det dR/dq), when asked for
 
     @property
     def unstable(self) -> bool:
@@ -98,6 +103,7 @@ class BoundaryTracer:
         self._exact: dict[tuple, tuple] = {}  # 2D: (contact set, Omega) -> (mu, max real, v, whole spectrum?)
         self._re_slope: float | None = None  # d Re(mu) / d(offset along the normal) at the last Hopf point [1/s/cell]
         self._gap_slope: dict[str, float] = {}  # d(signed gap) / d(offset), each side of the last event
+        self._sheet: float | None = None  # orientation of the maps' branch the curve being traced bounds
 
     # ------------------------------------------------------------------ coordinates
     def to_xy(self, speed: float, g0: float) -> np.ndarray:
@@ -158,9 +164,10 @@ class BoundaryTracer:
             self._exact[(cset, w)] = (mu, mr, None, True)
         return smp
 
-    def _jump(self, a: np.ndarray, b: np.ndarray, sa: Sample, n_sub: int = 6) -> float | None:
+    def _jump(self, a: np.ndarray, b: np.ndarray, sa: Sample, n_sub: int = 6) -> tuple[float, np.ndarray] | None:
         """Where the balanced solution continued from a towards b jumps to another branch (a fold of
-        the branch the maps follow), to 1e-6 of a cell; None if it is continuous."""
+        the branch the maps follow), to 1e-6 of a cell, with the last solution before it; None if it
+        is continuous."""
         ts = np.linspace(0.0, 1.0, n_sub + 1)
         qs = [sa.q]
         for t in ts[1:]:
@@ -196,11 +203,25 @@ class BoundaryTracer:
                 lo, q_lo = mid, q
             else:
                 hi = mid
-        return 0.5 * (lo + hi)
+        return 0.5 * (lo + hi), q_lo
 
-    def locate(self, a: np.ndarray, b: np.ndarray, sa: Sample, sb: Sample, depth: int = 0):
+    def _fold(self, a: np.ndarray, b: np.ndarray, sa: Sample, sb: Sample | None, jump: tuple[float, np.ndarray],
+              depth: int = 0, verify: bool = False):
+        """The fold point where the branch continued from a jumps. ``verify``: where the whole spectrum
+        just before the jump is unstable already, the boundary lies before it (located there)."""
+        t, q_end = jump
+        if verify and depth < 6:
+            tc = max(t - 1e-4, 0.0)
+            side = self.sample(a + tc * (b - a), q_end)  # the whole spectrum
+            if side is not None and side.unstable and tc > 0:
+                return self.locate(a, a + tc * (b - a), sa, side, depth + 1, verify)
+        return a + t * (b - a), "fold", sa, sb
+
+    def locate(self, a: np.ndarray, b: np.ndarray, sa: Sample, sb: Sample, depth: int = 0, verify: bool = False):
         """The boundary point between a (stable) and b (unstable): (position, kind, stable sample,
-        unstable sample)."""
+        unstable sample). ``verify``: check the stable side of a Hopf point by its whole spectrum;
+        where another mode is unstable there, it crossed first, and the boundary is its crossing
+        (between a and there): at seeds and corners, where the leading mode is not yet known."""
 
         def at(t: float, ref: Sample) -> Sample | None:
             return self.sample(a + t * (b - a), ref.q, ref)
@@ -214,13 +235,15 @@ class BoundaryTracer:
             self._rate = rate if self._rate is None else 0.5 * (self._rate + rate)
         if jump is not None:
             # the followed branch ends (a fold): the verdict changes with the branch
-            return a + jump * (b - a), "fold", sa, sb
+            return self._fold(a, b, sa, sb, jump, depth, verify)
 
         if sa.contact_set == sb.contact_set or self.continuous:
             state = {"s": sb}
 
             def re(t):
                 smp = at(t, state["s"])
+                if smp is None:  # lost from the last iterate: from the stable end, as the maps come
+                    smp = at(t, sa)
                 if smp is None:
                     return None
                 state["s"] = smp
@@ -229,6 +252,11 @@ class BoundaryTracer:
             t = illinois(re, sa.mu.real, sb.mu.real, 1e-7, 1e-8, max_iter=80)
             if t is None:
                 return None
+            if verify and depth < 6:
+                tc = max(t - 1e-4, 0.0)
+                side = self.sample(a + tc * (b - a), state["s"].q)  # the whole spectrum
+                if side is not None and side.unstable and tc > 0:
+                    return self.locate(a, a + tc * (b - a), sa, side, depth + 1, verify)
             self._re_slope = (sb.mu.real - sa.mu.real) / float(np.linalg.norm(b - a))
             return a + t * (b - a), "hopf", sa, state["s"]
         # a contact event in between: where the first differing point's gap crosses zero
@@ -257,8 +285,8 @@ class BoundaryTracer:
             return a + te * (b - a), "switch", left, right
         pa, pb = a + max(te - eps, 0.0) * (b - a), a + min(te + eps, 1.0) * (b - a)
         if left.unstable:  # the crossing is before the event
-            return self.locate(a, pa, sa, left, depth + 1)
-        return self.locate(pb, b, right, sb, depth + 1)
+            return self.locate(a, pa, sa, left, depth + 1, verify)
+        return self.locate(pb, b, right, sb, depth + 1, verify)
 
     # ------------------------------------------------------------------ the fast corrector
     # Along a curve the kind of boundary and (for an event) the contact point are known from the
@@ -485,11 +513,12 @@ class BoundaryTracer:
         self._rate = None
         self._re_slope = None
         self._gap_slope = {}
+        self._sheet = self.eq.orientation(sa.q, sa.omega, sa.g0)[0]  # the lattice sweeps like the maps
         if sb is None:
             jump = self._jump(a, b, sa)
-            first = None if jump is None else (a + jump * (b - a), "fold", sa, None)
+            first = None if jump is None else self._fold(a, b, sa, None, jump, verify=True)
         else:
-            first = self.locate(a, b, sa, sb)  # across a lattice edge: no continuity guard yet
+            first = self.locate(a, b, sa, sb, verify=True)  # across a lattice edge: no continuity guard yet
         if first is None:
             return None
         return self._trace(a, b, first, max_points)
@@ -511,10 +540,12 @@ class BoundaryTracer:
                     if c is None or np.linalg.norm(c - p) < 1e-6:
                         break
                 got = self._fast(c, n, pts[-1][1], ref)
-                if got is not None:
+                if got is not None and self._on_sheet(got[2]):
                     self.by_corrector["fast"] += 1
                 else:
                     got = self._bracket(c, n, ref, h)
+                    if got is not None and not self._on_sheet(got[2]):
+                        got = None  # past a fold of the maps' branch: a corner
                     self.by_corrector["bracket"] += got is not None
                 if got is None:
                     h *= 0.5
@@ -570,6 +601,20 @@ class BoundaryTracer:
             cv.normals.append((float(n[0]), float(n[1])))
         return cv
 
+    def _on_sheet(self, smp: Sample) -> bool:
+        """Is this (stable) solution on the sheet of balanced solutions the maps follow where the
+        curve was seeded? The maps' branch, swept down in g0 from large clearances, is a sheet over
+        the (Omega, g0) plane bounded by its fold curves, and sign(det dR/dq) is constant on it;
+        past a fold the tracer could follow a Hopf curve of the branch turned back there, which
+        bounds nothing the maps see (the corner where a Hopf curve meets a fold curve)."""
+        if self._sheet is None or not self.continuous:
+            # 2D: the maps also jump where Newton cycles between contact sets on a branch that goes on
+            # with the same orientation, so their solutions do not make one sheet
+            return True
+        if smp.orientation is None:
+            smp.orientation = self.eq.orientation(smp.q, smp.omega, smp.g0)[0]
+        return smp.orientation == self._sheet
+
     def _resample(self, smp: Sample) -> Sample:
         """The sample again with the whole spectrum (its event kept)."""
         full = self.sample(self._xy(smp), smp.q)
@@ -587,6 +632,8 @@ class BoundaryTracer:
         ring = [p + r * np.array([math.cos(a), math.sin(a)]) for a in angles]
         q0 = ref[0].q
         samples = [self.sample(x, q0, ref[0]) if self.inside(x) else None for x in ring]
+        # a stable solution off the maps' sheet is not what the maps see there
+        samples = [x if x is None or x.unstable or self._on_sheet(x) else None for x in samples]
         order = np.argsort(np.abs(angles - ang0))  # nearest to straight ahead first
         for k in order:
             for j in (k - 1, k + 1):
@@ -597,7 +644,7 @@ class BoundaryTracer:
                     # no solution on the followed branch there: it ends in between (a fold)
                     jump = self._jump(ring[k], ring[j], sk)
                     if jump is not None:
-                        return ring[k] + jump * (ring[j] - ring[k]), "fold", sk, None
+                        return self._fold(ring[k], ring[j], sk, None, jump)
                     continue
                 if sj is None:
                     continue
@@ -620,7 +667,7 @@ class BoundaryTracer:
                 # no equilibrium on the far side: the stable branch ends between (a fold)
                 jump = self._jump(a, b, sa)
                 if jump is not None:
-                    return a + jump * (b - a), "fold", sa, None
+                    return a + jump[0] * (b - a), "fold", sa, None
                 continue
             if sb is None:
                 continue
