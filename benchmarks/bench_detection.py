@@ -14,23 +14,13 @@
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
+from timing import best_of
 
 from rotorub_model.analyses.detection import closure, contact_map, linear_responses, run_detection
 from rotorub_model.analyses.linear import linear_response
 from rotorub_model.contact import make_contact
 from rotorub_model.structure.model import build_model
-
-
-def best_of(fn, repeat: int = 5) -> float:
-    best = np.inf
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t)
-    return best
 
 
 def main() -> None:

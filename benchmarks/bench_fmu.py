@@ -177,6 +177,7 @@ def main(argv: list[str] | None = None) -> int:
             return 2
 
     from fmpy import simulate_fmu
+    from timing import best_of
 
     from rotorub_model.analyses.transient import run_transient
     from rotorub_model.contact import make_contact
@@ -197,12 +198,7 @@ def main(argv: list[str] | None = None) -> int:
         return run_transient(model, contact, omega, t_end=t_end, t_ramp=1.0, me=me_max, record_dt=h, hold=h)
 
     def best(fn, *a):
-        ts = []
-        for _ in range(ns.repeat):
-            t0 = time.perf_counter()
-            fn(*a)
-            ts.append(time.perf_counter() - t0)
-        return min(ts)
+        return best_of(lambda: fn(*a), ns.repeat)
 
     def lean_time(path, h, input_name="imbalance", start_values=start):
         n = int(round(t_end / h))

@@ -27,7 +27,6 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import time
 import zipfile
 from pathlib import Path
 
@@ -35,15 +34,6 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "benchmarks"))
-
-
-def best(fn, repeat: int) -> float:
-    out = np.inf
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        out = min(out, time.perf_counter() - t)
-    return out
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -61,6 +51,7 @@ def main(argv: list[str] | None = None) -> int:
     from bench_fmu import Lean
     from bench_transient import bare_library
     from fmpy import read_model_description
+    from timing import best_of
 
     from rotorub_model import kernel
     from rotorub_model.analyses.transient import CentralDifference
@@ -112,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
             bare.bare_cd(c.kernel, mats, kernel.ptr(q), kernel.ptr(qp), h / 2, omega, n_sub, me)
 
         bare_run()
-        t_bare = best(bare_run, ns.repeat) / (ns.steps - 1)
+        t_bare = best_of(bare_run, ns.repeat) / (ns.steps - 1)
 
         n = ns.steps
         inputs = np.full(n, me)

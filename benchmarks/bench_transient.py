@@ -21,10 +21,10 @@ from __future__ import annotations
 import argparse
 import ctypes
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
+from timing import best_of
 
 from rotorub_model import kernel
 from rotorub_model.analyses.transient import CentralDifference, run_transient
@@ -33,15 +33,6 @@ from rotorub_model.kernel.compiler import compile_shared, host_suffix
 from rotorub_model.structure.model import build_model
 
 HERE = Path(__file__).resolve().parent
-
-
-def best_of(fn, repeat: int) -> float:
-    best = np.inf
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t)
-    return best
 
 
 def bare_library(tmp: Path) -> ctypes.CDLL:
