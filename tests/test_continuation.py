@@ -42,6 +42,19 @@ def settled(r, eq: Equilibria, record_dt: float) -> tuple[float, float]:
     return float(np.ptp(last, axis=0).max()), float(np.mean(np.diff(up)) * record_dt)
 
 
+def settles_from_unstable(model, eq: Equilibria, omega: float, g0: float, amplitude: float, dt: float,
+                          t_end: float) -> tuple[float, float, float]:
+    """A transient started next to the unstable static solution at (omega, g0), along its critical
+    eigenvector with the fan disk moved by ``amplitude`` [m], at step dt: (Re mu of the static
+    solution, then the settled peak-to-peak and period as :func:`settled` gives them)."""
+    qs = eq.solve(omega, g0)
+    mu, _ = eq.critical(qs, omega, g0)
+    q0, v0 = eq.unstable_start(qs, omega, g0, mu, amplitude)
+    r = run_transient(model, eq.contact(g0), omega, t_end=t_end, t_ramp=0.0, q0=q0, v0=v0, record_dt=2 * dt, dt=dt)
+    assert not r.diverged
+    return (mu.real, *settled(r, eq, 2 * dt))
+
+
 def test_hopf_point_is_located_to_1e_8(hopf_3d, w33):
     eq, b = hopf_3d
     assert b.complete
@@ -130,14 +143,8 @@ def test_transient_settles_on_the_predicted_orbit(model, w33):
     pred = orbit_from_state(eq, w33, g, near.x0[:n], near.x0[n:], near.period)
     assert pred is not None and pred.g0 == g and pred.residual < 1e-8
     # the transient at 0.33 mm from the unstable static solution, at the orbit's own step
-    qs = eq.solve(w33, g)
-    mu_s, _ = eq.critical(qs, w33, g)
-    assert mu_s.real > 0.3
-    q0, v0 = eq.unstable_start(qs, w33, g, mu_s, 1e-6)
-    dt = pred.period / 256
-    r = run_transient(model, eq.contact(g), w33, t_end=35.0, t_ramp=0.0, q0=q0, v0=v0, record_dt=2 * dt, dt=dt)
-    assert not r.diverged
-    ptp, period = settled(r, eq, 2 * dt)
+    re, ptp, period = settles_from_unstable(model, eq, w33, g, 1e-6, pred.period / 256, 35.0)
+    assert re > 0.3
     assert ptp == pytest.approx(pred.disk_peak_to_peak, rel=0.02)
     assert period == pytest.approx(pred.period, rel=0.01)
     # and the amplitude it settles on is not the linear growth's: the static solution was 1 um away
@@ -218,14 +225,8 @@ def test_transient_settles_on_the_orbit_born_at_the_hopf_point(hopf_3d, model, w
     br = continue_orbits_from_hopf(eq, w33, h.g0, h.mu, 0.3323e-3, max_orbits=30)
     pred = min(br.orbits, key=lambda o: abs(o.g0 - 0.3323e-3))
     assert pred.stable and abs(pred.g0 - 0.3323e-3) < 0.2e-6
-    g = pred.g0
-    qs = eq.solve(w33, g)
-    mu, _ = eq.critical(qs, w33, g)
-    assert mu.real > 0.02
-    q0, v0 = eq.unstable_start(qs, w33, g, mu, 0.25 * pred.disk_peak_to_peak)
-    dt = pred.period / 128
-    r = run_transient(model, eq.contact(g), w33, t_end=100.0, t_ramp=0.0, q0=q0, v0=v0, record_dt=2 * dt, dt=dt)
-    assert not r.diverged
-    ptp, period = settled(r, eq, 2 * dt)
+    re, ptp, period = settles_from_unstable(model, eq, w33, pred.g0, 0.25 * pred.disk_peak_to_peak,
+                                            pred.period / 128, 100.0)
+    assert re > 0.02
     assert ptp == pytest.approx(pred.disk_peak_to_peak, rel=0.02)
     assert period == pytest.approx(pred.period, rel=0.01)
