@@ -129,6 +129,12 @@ class BoundaryTracer:
                 return q
         return self.eq.solve(w, g, q0)  # then the solver's other starts, as the maps do
 
+    def _follow(self, p: np.ndarray, q0: np.ndarray, max_iter: int | None = None) -> np.ndarray | None:
+        """Newton from q0 alone at p (a continuation step, no other start); None where it fails."""
+        s, g = self.from_xy(p)
+        self.evaluations += 1
+        return self.eq.solve(s * self.wref, g, q0, follow=True, max_iter=max_iter)
+
     def sample(self, p: np.ndarray, q0: np.ndarray | None, previous: Sample | None = None) -> Sample | None:
         """The balanced solution at p and its stability. With ``previous`` (in the same contact set,
         or any in 3D) the critical eigenvalue is followed by Newton from it (no full spectrum)."""
@@ -171,9 +177,7 @@ class BoundaryTracer:
         ts = np.linspace(0.0, 1.0, n_sub + 1)
         qs = [sa.q]
         for t in ts[1:]:
-            s_, g_ = self.from_xy(a + t * (b - a))
-            q = self.eq.solve(s_ * self.wref, g_, qs[-1], follow=True)
-            self.evaluations += 1
+            q = self._follow(a + t * (b - a), qs[-1])
             if q is None:  # Newton lost the branch: it has ended (a fold) before this point
                 break
             qs.append(q)
@@ -196,9 +200,7 @@ class BoundaryTracer:
         tol = 1e-6 / float(np.linalg.norm(b - a))  # 1e-6 of a cell, as the other kinds
         while hi - lo > tol:
             mid = 0.5 * (lo + hi)
-            s_, g_ = self.from_xy(a + mid * (b - a))
-            q = self.eq.solve(s_ * self.wref, g_, q_lo, follow=True, max_iter=its)
-            self.evaluations += 1
+            q = self._follow(a + mid * (b - a), q_lo, its)
             if q is not None and np.linalg.norm(q - q_lo) <= 3.0 * rate * (mid - lo) + 1e-12:
                 lo, q_lo = mid, q
             else:
@@ -341,9 +343,8 @@ class BoundaryTracer:
         sign, ld0 = eq.orientation(q0, s0 * self.wref, g0)
 
         def on_branch(t, q_from, x_from):
+            q = self._follow(c + t * n, q_from)
             s_, g_ = self.from_xy(c + t * n)
-            self.evaluations += 1
-            q = eq.solve(s_ * self.wref, g_, q_from, follow=True)
             if q is None or float(np.linalg.norm(q - q_from)) > 50.0 * self._rate * float(
                     np.linalg.norm(c + t * n - x_from)):
                 return None, 0.0
@@ -443,10 +444,8 @@ class BoundaryTracer:
         sign = 1.0 if ra.contact_set[k] else -1.0  # signed gap: < 0 on the stable side
 
         def solve(t, q0):
-            s_, g_ = self.from_xy(c + t * n)
-            self.evaluations += 1
-            q = self.eq.solve(s_ * self.wref, g_, q0, follow=True)
-            return q, (None if q is None else sign * float(self.eq.gaps(q, g_).ravel()[k]))
+            q = self._follow(c + t * n, q0)
+            return q, (None if q is None else sign * float(self.eq.gaps(q, self.from_xy(c + t * n)[1]).ravel()[k]))
 
         # on this branch the contact set is the stable side's, or that with point k toggled past the
         # event (a switch). The 2D law is piecewise linear (friction saturated at these sliding
@@ -667,7 +666,7 @@ class BoundaryTracer:
                 # no equilibrium on the far side: the stable branch ends between (a fold)
                 jump = self._jump(a, b, sa)
                 if jump is not None:
-                    return a + jump[0] * (b - a), "fold", sa, None
+                    return self._fold(a, b, sa, None, jump)
                 continue
             if sb is None:
                 continue
