@@ -94,13 +94,13 @@ class Equilibria:
 
     def jacobian(self, q: np.ndarray, omega: float, g0: float) -> np.ndarray:
         """dR/dq = K(Omega) - dF_nl/dq."""
-        return self.model.K_omega(omega) - self._law(g0).jacobian(q, omega)
+        self._at_speed(omega)
+        return self._speed_cache[1] - self._law(g0).jacobian(q, omega)
 
     def orientation(self, q: np.ndarray, omega: float, g0: float) -> tuple[float, float]:
         """(sign, log|det|) of dR/dq. The sign changes across a fold, so it tells the two branches
         meeting there apart; approaching a smooth fold det^2 vanishes linearly in the parameter."""
-        self._at_speed(omega)
-        sign, logdet = np.linalg.slogdet(self._speed_cache[1] - self._law(g0).jacobian(q, omega))
+        sign, logdet = np.linalg.slogdet(self.jacobian(q, omega, g0))
         return float(sign), float(logdet)
 
     def d_param(self, q: np.ndarray, omega: float, g0: float, which: str) -> np.ndarray:
