@@ -31,7 +31,7 @@ def ref_params():
 def contact_fmu(tmp_path_factory):
     """RotorCasingContact.fmu built once from the working tree for every FMU test (read-only)."""
     pytest.importorskip("pythonfmu", reason="building the FMU needs pythonfmu (pip install -e '.[fmu]')")
-    from fmu_src.build import build_fmu
+    from fmu_src.build.pythonfmu_fmu import build_fmu
 
     return build_fmu(tmp_path_factory.mktemp("contact_fmu"), platforms=("linux64",))["fmu"]
 
@@ -40,7 +40,7 @@ def contact_fmu(tmp_path_factory):
 def native_fmu(tmp_path_factory):
     """The native (C) RotorCasingContact.fmu built once from the working tree, linux64 only."""
     pytest.importorskip("fmpy", reason="the native build takes the FMI headers from fmpy (pip install -e '.[fmu]')")
-    from fmu_src.build_native import build_native_fmu
+    from fmu_src.build.native_fmu import build_native_fmu
 
     return build_native_fmu(tmp_path_factory.mktemp("native_fmu"), platforms=("linux64",))["fmu"]
 

@@ -1,4 +1,4 @@
-"""The FMI cross-check kit next to each FMU (fmu_src/crosscheck.py): both flavours run it in two masters
+"""The FMI cross-check kit next to each FMU (fmu_src/build/crosscheck.py): both flavours run it in two masters
 (fmpy and OSP libcosim) and reproduce its reference outputs."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ import pytest
 
 pytest.importorskip("fmpy")
 
-from fmu_src import crosscheck as cc  # noqa: E402
+from fmu_src.build import crosscheck as cc  # noqa: E402
 
 
 @pytest.fixture(scope="module")

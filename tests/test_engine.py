@@ -1,8 +1,8 @@
 """Engine coupling: the LP spool FMU, the SSP of the coupled system, the fmpy co-simulation master.
 
 Both FMUs are built once from the current sources into a temporary folder (the
-contact FMU with fmu_src/build.py, the spool FMU with fmu_src.coupling.build_spool_fmu).
-The coupled scenario (fmu_src.coupling.scenario_settings(quick=True)): the spool runs up
+contact FMU with fmu_src/build/pythonfmu_fmu.py, the spool FMU with fmu_src.engine.coupling.build_spool_fmu).
+The coupled scenario (fmu_src.engine.coupling.scenario_settings(quick=True)): the spool runs up
 from 2.8 to 4.2 x omega_ref (half-cosine, 0.5 s -> 4.5 s) through the first critical
 speed (3.49 x omega_ref) with the reference imbalance 22 kg mm, 3D contact, h = 1 ms,
 once with the rub disabled (g0 = 1 m) and once with g0 = 1 mm.
@@ -25,7 +25,7 @@ pytest.importorskip("lxml")
 from fmpy.fmi1 import FMICallException  # noqa: E402
 from fmpy.validation import validate_fmu  # noqa: E402
 
-from fmu_src.coupling import (  # noqa: E402
+from fmu_src.engine.coupling import (  # noqa: E402
     CONNECTIONS,
     EngineError,
     FmuInstance,
@@ -39,7 +39,7 @@ from fmu_src.coupling import (  # noqa: E402
 
 CFG = scenario_settings(quick=True)
 SP = CFG["spool_params"]
-J_REF, CW_REF = 55.5, 0.05  # the spool FMU's defaults (fmu_src/spool_slave.py)
+J_REF, CW_REF = 55.5, 0.05  # the spool FMU's defaults (fmu_src/pythonfmu/spool_slave.py)
 
 
 def schedule(t, w0=SP["Omega0"], w1=SP["Omega1"], t1=SP["t_ramp_start"], T=SP["t_ramp"]):
@@ -295,7 +295,7 @@ def test_ssp_runs_in_libcosim_and_gives_the_fmpy_master_loops_spool_speed(flavou
     either contact FMU: with rub, its spool speed and friction torque are the fmpy loop's (both masters
     exchange at the communication points and hold the inputs over the step)."""
     pytest.importorskip("libcosimpy", reason="libcosimpy: Linux x86_64, Python >= 3.11")
-    from fmu_src.ssp import run_ssp_libcosim
+    from fmu_src.engine.ssp import run_ssp_libcosim
 
     contact = Path(request.getfixturevalue("contact_fmu" if flavour == "pythonfmu" else "native_fmu"))
     t_end = 1.2

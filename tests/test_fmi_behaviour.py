@@ -170,11 +170,11 @@ def test_quasi_static_build_declares_and_has_its_feedthrough(flavour_qs, tmp_pat
     """Built with mode = quasi_static, the outputs depend on Omega and imbalance, and they are the balanced
     solution at the inputs just set: read before any step, they follow the input."""
     if flavour_qs == "pythonfmu":
-        from fmu_src.build import build_fmu
+        from fmu_src.build.pythonfmu_fmu import build_fmu
 
         fmu = build_fmu(tmp_path / "qs", platforms=("linux64",), mode="quasi_static")["fmu"]
     else:
-        from fmu_src.build_native import build_native_fmu
+        from fmu_src.build.native_fmu import build_native_fmu
 
         fmu = build_native_fmu(tmp_path / "qs", platforms=("linux64",), mode="quasi_static")["fmu"]
     unz = extract(fmu, str(tmp_path / "qs_unz"))

@@ -16,7 +16,7 @@ import pytest
 fmpy = pytest.importorskip("fmpy", reason="the FMU tests drive the FMU with fmpy (pip install -e '.[fmu]')")
 pytest.importorskip("pythonfmu", reason="building the FMU needs pythonfmu (pip install -e '.[fmu]')")
 
-from fmu_src.fmi_run import FMUError, Slave, simulate  # noqa: E402
+from fmu_src.harness.fmi_run import FMUError, Slave, simulate  # noqa: E402
 from rotorub_model.analyses.stability import stability_of  # noqa: E402
 from rotorub_model.analyses.static import solve_static  # noqa: E402
 from rotorub_model.analyses.transient import critical_time_step, run_transient  # noqa: E402

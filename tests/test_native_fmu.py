@@ -22,8 +22,8 @@ import pytest
 
 pytest.importorskip("fmpy")
 
-from fmu_src.binaries import exported_symbols, missing_fmi_functions  # noqa: E402
-from fmu_src.fmi_run import Slave  # noqa: E402
+from fmu_src.build.binaries import exported_symbols, missing_fmi_functions  # noqa: E402
+from fmu_src.harness.fmi_run import Slave  # noqa: E402
 
 ARCH = {"linux64": "x86_64", "win64": "x86_64", "darwin64": "x86_64", "aarch64-darwin": "aarch64"}
 FN = [f"blade[{j}].F_N" for j in range(1, 11)] + ["friction_torque", "disk_displacement.x"]
@@ -32,7 +32,7 @@ FN = [f"blade[{j}].F_N" for j in range(1, 11)] + ["friction_torque", "disk_displ
 @pytest.fixture(scope="module")
 def all_platforms(tmp_path_factory):
     pytest.importorskip("ziglang", reason="cross-compiling the FMU needs ziglang (a dependency of rotorub)")
-    from fmu_src.build_native import build_native_fmu
+    from fmu_src.build.native_fmu import build_native_fmu
 
     out = build_native_fmu(tmp_path_factory.mktemp("native_all"))
     assert set(out["platforms"]) == set(ARCH), out

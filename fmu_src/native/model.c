@@ -1,6 +1,6 @@
 /*
  * model.c: RotorCasingContact in C, around the rotorub kernel. The same steps as the pythonfmu
- * slave (fmu_src/rotorub_casing_contact.py) and the library, in the same order of operations,
+ * slave (fmu_src/pythonfmu/rotorub_casing_contact.py) and the library, in the same order of operations,
  * so that the three give the same numbers:
  *
  *   transient     a step h is n = ceil(h / cap) kernel substeps, cap = min(dt_max, half the

@@ -1,12 +1,12 @@
 """Engine coupling: the LP spool's speed as a second FMU, the coupled system as an SSP, an fmpy master.
 
-    python -m fmu_src.coupling OUT_DIR [--full] [--contact-fmu F] [--spool-fmu F]
+    python -m fmu_src.engine.coupling OUT_DIR [--full] [--contact-fmu F] [--spool-fmu F]
 
-This module is the master loop and the scenario; the spool FMU is fmu_src/spool.py's, the SSP
-package fmu_src/ssp.py's, what they share fmu_src/system.py's. Pieces:
+This module is the master loop and the scenario; the spool FMU is fmu_src/engine/spool.py's, the SSP
+package fmu_src/engine/ssp.py's, what they share fmu_src/engine/system.py's. Pieces:
 
-* :func:`build_spool_fmu` builds ``LPSpool.fmu`` from fmu_src/spool_slave.py with
-  pythonfmu (same recipe as fmu_src/build.py: the script is staged under a hashed
+* :func:`build_spool_fmu` builds ``LPSpool.fmu`` from fmu_src/pythonfmu/spool_slave.py with
+  pythonfmu (same recipe as fmu_src/build/pythonfmu_fmu.py: the script is staged under a hashed
   module name, ``lpspool_<hash>``, because every pythonfmu FMU in a process shares
   one ``sys.modules``). The spool: J dOmega/dt = tau_drive(t) - c_w Omega^2 +
   friction_torque, with a drive torque schedule that makes the rub-free spool follow
@@ -57,7 +57,7 @@ import numpy as np
 
 from rotorub_model.results import pyplot, save_figure, write_json
 
-from .fmi_run import FMUError, Slave
+from ..harness.fmi_run import FMUError, Slave
 from .spool import build_contact_fmu, build_spool_fmu, spool_defaults  # noqa: F401 - the engine system's API
 from .ssp import ssp_contents, validate_ssp, write_ssp  # noqa: F401
 from .system import (  # noqa: F401
@@ -80,7 +80,7 @@ def _trapezoid(y: np.ndarray, x: np.ndarray) -> float:
 
 
 class FmuInstance(Slave):
-    """A :class:`~fmu_src.fmi_run.Slave` created uninitialised (logging on, variables by name);
+    """A :class:`~fmu_src.harness.fmi_run.Slave` created uninitialised (logging on, variables by name);
     :meth:`initialize` raises :class:`EngineError` when the FMU logs an fmi2Error while
     initializing (pythonfmu reports a refused configuration that way, with fmi2OK)."""
 

@@ -1,6 +1,6 @@
 """The FMU side's commands for the ``rotorub`` CLI, found through entry points (the library never imports this
 package): ``build-fmu`` (group ``rotorub.commands``) and the FMU part of ``reproduce`` (group
-``rotorub.reproduce``, fmu_src/reproduce_fmu.py)."""
+``rotorub.reproduce``, fmu_src/harness/reproduce.py)."""
 
 from __future__ import annotations
 
@@ -26,11 +26,11 @@ def build(dest: str | Path, params: str | Path | None = None, native: bool = Fal
     from . import crosscheck
 
     if native:
-        from .build_native import build_native_fmu
+        from .native_fmu import build_native_fmu
 
         out = build_native_fmu(dest, params, platforms, mode)
     else:
-        from .build import build_fmu
+        from .pythonfmu_fmu import build_fmu
 
         out = build_fmu(dest, params, platforms, mode)
     kit = crosscheck.write_kit(Path(out["fmu"]).parent, load_parameters(params) if params else None)
@@ -41,8 +41,8 @@ def _run_build(ns: argparse.Namespace) -> dict:
     from rotorub_model.errors import ParameterError
     from rotorub_model.kernel.compiler import CompilerError
 
-    from .build import BuildError
-    from .build_native import NativeBuildError
+    from .pythonfmu_fmu import BuildError
+    from .native_fmu import NativeBuildError
 
     default = Path("fmus") / ("native" if ns.native else "")
     dest = default if ns.out == "out/build-fmu" else Path(ns.out)

@@ -1,4 +1,4 @@
-"""The LP spool FMU (fmu_src/spool_slave.py, built with pythonfmu) and the contact FMU for the engine system.
+"""The LP spool FMU (fmu_src/pythonfmu/spool_slave.py, built with pythonfmu) and the contact FMU for the engine system.
 
 The spool: J dOmega/dt = tau_drive(t) - c_w Omega^2 + friction_torque, with a drive torque
 schedule that makes the rub-free spool follow a half-cosine run-up Omega0 -> Omega1 exactly
@@ -17,13 +17,13 @@ from pathlib import Path
 
 from .system import SPOOL_ID, EngineError
 
-HERE = Path(__file__).resolve().parent
-SPOOL_SCRIPT = HERE / "spool_slave.py"
+HERE = Path(__file__).resolve().parent.parent  # fmu_src/
+SPOOL_SCRIPT = HERE / "pythonfmu" / "spool_slave.py"
 
 
 def spool_defaults() -> dict:
-    """The spool FMU's default parameter values (module defaults of fmu_src/spool_slave.py)."""
-    from . import spool_slave
+    """The spool FMU's default parameter values (module defaults of fmu_src/pythonfmu/spool_slave.py)."""
+    from ..pythonfmu import spool_slave
 
     return dict(spool_slave.DEFAULTS)
 
@@ -86,8 +86,8 @@ def build_spool_fmu(dest: str | Path = "fmus", **defaults) -> Path:
 
 
 def build_contact_fmu(dest: str | Path = "fmus") -> Path:
-    """``RotorCasingContact.fmu`` from fmu_src/build.py (reference parameters)."""
-    from .build import build_fmu
+    """``RotorCasingContact.fmu`` from fmu_src/build/pythonfmu_fmu.py (reference parameters)."""
+    from ..build.pythonfmu_fmu import build_fmu
 
     return Path(build_fmu(dest)["fmu"])
 

@@ -33,7 +33,7 @@ from .system import (
     read_description,
 )
 
-HERE = Path(__file__).resolve().parent
+HERE = Path(__file__).resolve().parent.parent  # fmu_src/
 SCHEMA_DIR = HERE / "schemas" / "ssp1"
 NS = {
     "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
@@ -145,7 +145,7 @@ def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, 
                       description="Low-pressure spool of a turbofan coupled with the blade-tip/casing contact of its "
                                   "fan: the spool's speed drives the contact model, the contact's friction torque "
                                   "brakes the spool",
-                      generationTool="rotorub fmu_src.ssp")
+                      generationTool="rotorub fmu_src.engine.ssp")
     system = ET.SubElement(root, _q("ssd", "System"), name=name)
     elements = ET.SubElement(system, _q("ssd", "Elements"))
     comps = (

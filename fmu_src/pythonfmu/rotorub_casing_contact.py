@@ -1,7 +1,7 @@
 """RotorCasingContact: FMI 2.0 co-simulation slave around the rotorub library (pythonfmu).
 
 This file is the pythonfmu script of the pythonfmu flavour of ``RotorCasingContact.fmu``
-(built by ``rotorub build-fmu``, see fmu_src/build.py and fmu_src/FMU.md). It contains no
+(built by ``rotorub build-fmu``, see fmu_src/build/pythonfmu_fmu.py and fmu_src/FMU.md). It contains no
 physics: every number it outputs comes from the copy of ``rotorub_model`` carried in the FMU's
 resources folder (imported under a build-specific package name so it never collides with
 another copy of the library, or another pythonfmu FMU, in the same interpreter):

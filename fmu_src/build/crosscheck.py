@@ -85,7 +85,7 @@ interpolate linearly: the same), and compare the outputs with {NAME}_ref.csv: th
 (the FMU computes them in double precision with the same operations as the reference; 1e-9 relative to
 each column's largest value is a generous bound). The outputs at t = 0 are those after initialisation.
 
-Reference written by rotorub (fmu_src/crosscheck.py) from the library's run_transient(hold=h).
+Reference written by rotorub (fmu_src/build/crosscheck.py) from the library's run_transient(hold=h).
 """)
     return files
 

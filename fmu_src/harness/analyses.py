@@ -7,7 +7,7 @@
   master) at one point, 2D and 3D, with the normal force histories (paper Fig. 12);
 * :func:`run_up`: an acceleration through the first critical speed with Omega(t) as input.
 
-The FMU is driven through :class:`fmu_src.fmi_run.Slave`; the library side of every
+The FMU is driven through :class:`fmu_src.harness.fmi_run.Slave`; the library side of every
 comparison is the library's own analysis of the same case. A master holds inputs over
 each communication step, so the library transients are run with ``hold=h`` (the same
 zero-order hold): both sides then do the same arithmetic and differ by round-off.

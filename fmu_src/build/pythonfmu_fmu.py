@@ -1,10 +1,10 @@
 """Build fmus/RotorCasingContact.fmu from the slave script and a copy of the library.
 
-    rotorub build-fmu [--params my.toml] [--out fmus]      (or: python fmu_src/build.py [DEST])
+    rotorub build-fmu [--params my.toml] [--out fmus]      (or: python fmu_src/build/pythonfmu_fmu.py [DEST])
 
 The FMU carries, in its resources folder:
 
-* ``rotorub_casing_contact_<h>.py``: the pythonfmu slave (fmu_src/rotorub_casing_contact.py);
+* ``rotorub_casing_contact_<h>.py``: the pythonfmu slave (fmu_src/pythonfmu/rotorub_casing_contact.py);
 * ``rotorub_model_<h>/``: a verbatim copy of the ``rotorub_model`` sources and data, with
   the compiled kernel in ``kernel/bin/<machine>-<os>/`` (x86_64-linux, and x86_64-win when
   ziglang can cross-compile it: the platforms pythonfmu's binary exists for);
@@ -35,13 +35,13 @@ import tempfile
 import zipfile
 from pathlib import Path
 
-HERE = Path(__file__).resolve().parent
-SCRIPT = HERE / "rotorub_casing_contact.py"
+HERE = Path(__file__).resolve().parent.parent  # fmu_src/
+SCRIPT = HERE / "pythonfmu" / "rotorub_casing_contact.py"
 INTERFACE = HERE / "interface.py"
 import rotorub_model  # noqa: E402 - the sources that travel inside the FMU, wherever they are installed
 
 LIB = Path(rotorub_model.__file__).resolve().parent
-from . import interface  # noqa: E402
+from .. import interface  # noqa: E402
 
 MODEL_IDENTIFIER = "RotorCasingContact"
 HOST_REQUIREMENTS = ["numpy>=1.26"]
@@ -82,7 +82,7 @@ def _patch_exit_double_release(fmu: Path) -> bool:
     so = bytearray(data.get(member, b""))
     if hashlib.sha256(so).hexdigest() != _PYTHONFMU_SO_SHA256:
         print(f"build-fmu: warning: {member} is not pythonfmu 0.7.0's known binary: its exit-time double release "
-              "is not patched (processes may abort at exit; see fmu_src/build.py)", file=sys.stderr)
+              "is not patched (processes may abort at exit; see fmu_src/build/pythonfmu_fmu.py)", file=sys.stderr)
         return False
     o = _ON_UNLOAD_OFFSET
     if so[o:o + 5] != _ON_UNLOAD_BYTES:

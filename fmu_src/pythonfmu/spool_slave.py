@@ -1,7 +1,7 @@
 """LPSpool: FMI 2.0 co-simulation slave for the speed of the low-pressure spool.
 
 This file is the pythonfmu script of ``LPSpool.fmu`` (built by
-:func:`fmu_src.spool.build_spool_fmu`, which stages it under a hashed module name,
+:func:`fmu_src.engine.spool.build_spool_fmu`, which stages it under a hashed module name,
 ``lpspool_<hash>``: every pythonfmu FMU in a process shares one ``sys.modules``).
 It is self-contained: numpy is not even needed.
 

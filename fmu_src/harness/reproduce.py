@@ -21,8 +21,8 @@ def _step(msg: str) -> None:
 def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: str | Path = "fmus",
                  params_file: str | Path | None = None, progress: bool = True) -> dict:
     """Returns the additions to the summary: harness results, fmu_vs_library_max_rel_diff, coupled_run."""
-    from .commands import build
-    from .harness import quasi_static_maps, run_up, transient_pair
+    from ..build.commands import build
+    from .analyses import quasi_static_maps, run_up, transient_pair
 
     out = Path(out)
     _step(f"building both FMU flavours (pythonfmu into {fmu_dir}/, native C into {fmu_dir}/native/), with their "
@@ -73,9 +73,9 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
         "branch are counted in harnesses.quasi_static.vs_library)")
 
     try:
-        from .coupling import run_coupled_scenario
+        from ..engine.coupling import run_coupled_scenario
     except ImportError as exc:  # the engine coupling is part of the package; say so if it is broken
-        raise RuntimeError(f"fmu_src.coupling is not importable: {exc}") from exc
+        raise RuntimeError(f"fmu_src.engine.coupling is not importable: {exc}") from exc
     _step("coupled engine scenario: LP spool FMU + contact FMU, fmpy master loop, SSP file")
     coupled = run_coupled_scenario(out / "coupled", quick=quick, contact_fmu=fmu, fmu_dir=fmu_dir)
     res["coupled_run"] = coupled
@@ -95,7 +95,7 @@ def compare_flavours(native: str | Path, pythonfmu: str | Path, model, speed: fl
     from rotorub_model.analyses.transient import run_transient
     from rotorub_model.contact import make_contact
 
-    from .harness import _extract, _rel_diff, run_fmu_transient
+    from .analyses import _extract, _rel_diff, run_fmu_transient
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
