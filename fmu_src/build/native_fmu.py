@@ -36,7 +36,7 @@ from .. import interface
 HERE = Path(__file__).resolve().parent.parent  # fmu_src/
 NATIVE = HERE / "native"
 C_SOURCES = ("fmi2_cs.c", "model.c", "model_data.c", "rotorub_kernel.c")
-HEADERS = ("model.h", "rotorub_kernel.h")
+HEADERS = ("model.h", "rotorub_kernel.h", "rr_math.h")
 FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 SUFFIX = {"linux64": ".so", "aarch64-linux": ".so", "win64": ".dll", "darwin64": ".dylib", "aarch64-darwin": ".dylib"}
 ALL_PLATFORMS = ("linux64", "win64", "darwin64", "aarch64-darwin")
@@ -150,7 +150,7 @@ def stage_sources(dest: Path, model_data: str) -> None:
 
     for name in ("fmi2_cs.c", "model.c", "model.h"):
         shutil.copy2(NATIVE / name, dest / name)
-    for src in (*kernel.SOURCES, kernel.HEADER):
+    for src in (*kernel.SOURCES, *kernel.HEADERS):
         shutil.copy2(src, dest / src.name)
     hdr = fmi_headers()
     for name in FMI_HEADERS:

@@ -29,6 +29,8 @@ from .compiler import CFLAGS, CompilerError, compile_shared, host_platform_tag, 
 HERE = Path(__file__).resolve().parent
 SOURCES = (HERE / "rotorub_kernel.c",)
 HEADER = HERE / "rotorub_kernel.h"
+MATH_HEADER = HERE / "rr_math.h"  # the elementary functions: the same bits on every platform
+HEADERS = (HEADER, MATH_HEADER)
 ABI_VERSION = 5
 LAW_WIDTH = 7
 OUT_BLADE_BLOCKS = 6
@@ -84,7 +86,7 @@ class RRJob(ctypes.Structure):
 def source_id() -> str:
     """Hash of the kernel's sources and compiler flags (names the binary; checked when loading one)."""
     h = hashlib.sha256(" ".join(CFLAGS).encode())
-    for p in (*SOURCES, HEADER):
+    for p in (*SOURCES, *HEADERS):
         h.update(p.name.encode())
         h.update(p.read_bytes().replace(b"\r\n", b"\n"))
     return h.hexdigest()[:16]
@@ -148,6 +150,8 @@ def _declare(lib: ctypes.CDLL) -> ctypes.CDLL:
     lib.rr_gaps_batch.argtypes = [c, ctypes.c_int, _dp, _dp]
     lib.rr_outputs.argtypes = [c, _dp, _dp, ctypes.c_double, ctypes.c_double, _ip, _dp]
     lib.rr_outputs_batch.argtypes = [c, ctypes.c_int, _dp, _dp, ctypes.c_double, _dp]
+    lib.rr_elementary.argtypes = [ctypes.c_int, ctypes.c_int, _dp, _dp, _dp]
+    lib.rr_elementary.restype = None
     lib.rr_cd_run.argtypes = [ctypes.c_void_p]
     lib.rr_cd_run.restype = ctypes.c_int
     for name in ("rr_blade_law", "rr_laws", "rr_friction", "rr_force", "rr_jacobian", "rr_gaps_batch", "rr_outputs",
@@ -232,6 +236,21 @@ def inverse(A: np.ndarray) -> np.ndarray:
     return out
 
 
+ELEMENTARY = ("sin", "cos", "tan", "atan2", "tanh", "exp", "sqrt", "floor", "ceil")  # rr_elementary's codes
+
+
+def elementary(name: str, x, y=None) -> np.ndarray:
+    """The kernel's own elementary function ``name`` (rr_math.h) on an array: what every platform's build
+    computes bit for bit (atan2: ``elementary("atan2", y, x)``, C's argument order)."""
+    if name not in ELEMENTARY:
+        raise ValueError(f"elementary: '{name}' unknown; accepted: {', '.join(ELEMENTARY)}")
+    a = np.ascontiguousarray(x, dtype=float).ravel()
+    b = np.ascontiguousarray(a if y is None else np.broadcast_to(y, np.shape(x)), dtype=float).ravel()
+    out = np.empty_like(a)
+    load().rr_elementary(ELEMENTARY.index(name), a.size, ptr(a), ptr(b), ptr(out))
+    return out.reshape(np.shape(x))
+
+
 def ptr(a: np.ndarray) -> int:
     """Address of a C-contiguous float64 array, for a double* argument (the array must outlive its use)."""
     if a.dtype != np.float64 or not a.flags.c_contiguous:
@@ -248,6 +267,7 @@ def iptr(a: np.ndarray) -> int:
 
 __all__ = [
     "ABI_VERSION", "CompilerError", "LAW_WIDTH", "OUT_BLADE_NAMES", "OUT_GLOBAL_NAMES", "RRContact", "RRGeometry",
-    "RRGeometrySpec", "RRJob", "RRMatrices", "RRState", "build", "cache_dir", "chord_law", "eigenvalues", "inverse",
+    "RRGeometrySpec", "RRJob", "RRMatrices", "RRState", "build", "cache_dir", "chord_law", "eigenvalues", "elementary",
+    "inverse",
     "iptr", "load", "point_law", "ptr", "source_id",
 ]

@@ -4,6 +4,8 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "rr_math.h" /* sin, cos, tan, atan2, tanh, sqrt: the same bits on every platform */
+
 #ifndef RR_SOURCE_ID
 #define RR_SOURCE_ID "unversioned"
 #endif
@@ -14,6 +16,25 @@ const char *rr_source_id(void) { return RR_SOURCE_ID; }
 
 /* scratch: gaps (nb*np) + law (nb*7) + friction (nb*np) + right-hand side (n) */
 int rr_work_size(int n, int nb, int np) { return nb * np + nb * RR_LAW_WIDTH + nb * np + n; }
+
+void rr_elementary(int fn, int m, const double *x, const double *y, double *out)
+{
+    int i;
+    for (i = 0; i < m; ++i) {
+        switch (fn) {
+        case RR_FN_SIN: out[i] = rr_sin(x[i]); break;
+        case RR_FN_COS: out[i] = rr_cos(x[i]); break;
+        case RR_FN_TAN: out[i] = rr_tan(x[i]); break;
+        case RR_FN_ATAN2: out[i] = rr_atan2(x[i], y[i]); break;
+        case RR_FN_TANH: out[i] = rr_tanh(x[i]); break;
+        case RR_FN_EXP: out[i] = rr_exp(x[i]); break;
+        case RR_FN_SQRT: out[i] = rr_sqrt(x[i]); break;
+        case RR_FN_FLOOR: out[i] = rr_floor(x[i]); break;
+        case RR_FN_CEIL: out[i] = rr_ceil(x[i]); break;
+        default: out[i] = 0.0; break; /* unreachable from kernel.elementary(), which checks the name */
+        }
+    }
+}
 
 /* ------------------------------------------------------------------ geometry */
 
@@ -27,7 +48,7 @@ int rr_work_size(int n, int nb, int np) { return nb * np + nb * RR_LAW_WIDTH + n
 static void casing_point_map(const rr_geometry_spec *s, const double *P, int tilt, double *D, int nc)
 {
     double x = P[0], y = P[1], z = P[2];
-    double alpha = atan2(y, x), ca = cos(alpha), sa = sin(alpha);
+    double alpha = rr_atan2(y, x), ca = rr_cos(alpha), sa = rr_sin(alpha);
     double az = z - s->z_cg;
     int i, r;
     for (r = 0; r < 3 * nc; ++r) D[r] = 0.0;
@@ -42,8 +63,8 @@ static void casing_point_map(const rr_geometry_spec *s, const double *P, int til
     }
     for (i = 0; i < s->n_modes; ++i) {
         double nn = (double)s->modes[i];
-        double uc = cos(nn * alpha), us = sin(nn * alpha);
-        double wc = -sin(nn * alpha) / nn, ws = cos(nn * alpha) / nn;
+        double uc = rr_cos(nn * alpha), us = rr_sin(nn * alpha);
+        double wc = -rr_sin(nn * alpha) / nn, ws = rr_cos(nn * alpha) / nn;
         /* e_r = (ca, sa, 0), e_t = (-sa, ca, 0) */
         D[0 * nc + 4 + 2 * i] = uc * ca + wc * -sa;
         D[1 * nc + 4 + 2 * i] = uc * sa + wc * ca;
@@ -57,11 +78,11 @@ int rr_contact_geometry(const rr_geometry_spec *s, rr_geometry *o)
     int n = s->n, nb = s->nb, np = s->np, nc = 4 + 2 * s->n_modes;
     int j, k, i, e, r;
     double D[3 * (4 + 2 * 16)];
-    double cb = cos(s->stagger), sb = sin(s->stagger), tth = tan(s->theta), cth = cos(s->theta), sth = sin(s->theta);
+    double cb = rr_cos(s->stagger), sb = rr_sin(s->stagger), tth = rr_tan(s->theta), cth = rr_cos(s->theta), sth = rr_sin(s->theta);
     if ((np != 1 && np != 2) || (np == 2 && !(s->chord > 0.0)) || s->n_modes > 16) return -1;
     for (j = 0; j < nb; ++j) {
         double a = 2.0 * M_PI * j / nb;
-        double er[3] = {cos(a), sin(a), 0.0}, et[3] = {-sin(a), cos(a), 0.0};
+        double er[3] = {rr_cos(a), rr_sin(a), 0.0}, et[3] = {-rr_sin(a), rr_cos(a), 0.0};
         for (k = 0; k < np; ++k) {
             size_t pk = (size_t)j * np + k;
             double *P = o->points + 3 * pk, *nv = o->normals + 3 * pk, *tv = o->tangents + 3 * pk;
@@ -79,13 +100,13 @@ int rr_contact_geometry(const rr_geometry_spec *s, rr_geometry *o)
                 double cdir[3] = {cb * 0.0 - sb * et[0], cb * 0.0 - sb * et[1], cb * 1.0 - sb * et[2]};
                 double P0[3] = {s->r_tip * er[0] + c * cdir[0], s->r_tip * er[1] + c * cdir[1],
                                 s->r_tip * er[2] + c * cdir[2]};
-                double z = P0[2], ap = atan2(P0[1], P0[0]);
-                double erho[3] = {cos(ap), sin(ap), 0.0};
+                double z = P0[2], ap = rr_atan2(P0[1], P0[0]);
+                double erho[3] = {rr_cos(ap), rr_sin(ap), 0.0};
                 double rad = s->r_tip - z * tth; /* tip cut parallel to the cone */
                 for (i = 0; i < 3; ++i) P[i] = rad * erho[i] + z * (i == 2 ? 1.0 : 0.0);
                 for (i = 0; i < 3; ++i) nv[i] = cth * erho[i] + sth * (i == 2 ? 1.0 : 0.0);
-                tv[0] = -sin(ap);
-                tv[1] = cos(ap);
+                tv[0] = -rr_sin(ap);
+                tv[1] = rr_cos(ap);
                 tv[2] = 0.0;
             }
             /* blade point: disk translation (+ disk rotation x position + tip flexure in 3D) */
@@ -275,7 +296,7 @@ static void friction_of(const rr_contact *c, const double *law, double omega, co
                     for (e = 0; e < n; ++e) sv += S[e] * (q[e] - q_prev[e]);
                 v += qdot ? sv : sv / dt;
             }
-            fr[pk] = c->mu * tanh(v / c->v_slip);
+            fr[pk] = c->mu * rr_tanh(v / c->v_slip);
         }
     }
 }
@@ -413,8 +434,8 @@ static void outputs_from_law(const rr_contact *c, const double *q, const double 
         dx += c->T2[k] * q[k];
         dy += c->T2[n + k] * q[k];
     }
-    cs = cos(phi);
-    sn = sin(phi);
+    cs = rr_cos(phi);
+    sn = rr_sin(phi);
     vals[RR_OUT_CASING_X] = cs * Fc[0] - sn * Fc[1];
     vals[RR_OUT_CASING_Y] = sn * Fc[0] + cs * Fc[1];
     vals[RR_OUT_CASING_Z] = Fc[2];
@@ -658,7 +679,7 @@ static void hessenberg(int n, double *a, double *v)
             v[i] = a[(size_t)i * n + k] / scale;
             h += v[i] * v[i];
         }
-        g = sqrt(h);
+        g = rr_sqrt(h);
         if (v[k + 1] > 0.0) g = -g;
         h -= v[k + 1] * g;
         v[k + 1] -= g;
@@ -714,7 +735,7 @@ static int hqr(int n, double *a, double *wr, double *wi)
                 if (l == nn - 1) { /* two roots */
                     p = 0.5 * (y - x);
                     q = p * p + w;
-                    z = sqrt(fabs(q));
+                    z = rr_sqrt(fabs(q));
                     x += t;
                     if (q >= 0.0) {
                         z = p + (p >= 0.0 ? fabs(z) : -fabs(z));
@@ -768,7 +789,7 @@ static int hqr(int n, double *a, double *wr, double *wi)
                                 r /= x;
                             }
                         }
-                        s = sqrt(p * p + q * q + r * r);
+                        s = rr_sqrt(p * p + q * q + r * r);
                         if (p < 0.0) s = -s;
                         if (s != 0.0) {
                             if (k == m) {
@@ -856,7 +877,7 @@ static double norm2(int n, const double *x)
                 ssq += (a / scale) * (a / scale);
             }
         }
-    return scale * sqrt(ssq);
+    return scale * rr_sqrt(ssq);
 }
 
 /* R = K x - F_nl(x) - lam F; returns |R| */

@@ -1,6 +1,6 @@
 /*
  * rotorub kernel: the hot path of the blade-tip / casing contact model in portable C99
- * (libm only). One source, used by the Python library (through ctypes), by the pythonfmu
+ * (no libm on x86_64 and aarch64: the elementary functions are rr_math.h's). One source, used by the Python library (through ctypes), by the pythonfmu
  * FMU (a prebuilt copy in its resources) and by the native FMI 2.0 FMU.
  *
  * What it holds:
@@ -73,6 +73,11 @@ enum {
     RR_OUT_N_CONTACT,                                       /* blades with F_N > 0 */
     RR_OUT_GLOBALS
 };
+/* The kernel's elementary functions (rr_math.h), for tests: out[i] = f(x[i]) (atan2: f(x[i], y[i]), y-first
+ * as C's atan2(y, x) takes them: x holds the first argument). */
+enum { RR_FN_SIN, RR_FN_COS, RR_FN_TAN, RR_FN_ATAN2, RR_FN_TANH, RR_FN_EXP, RR_FN_SQRT, RR_FN_FLOOR, RR_FN_CEIL };
+RR_API void rr_elementary(int fn, int m, const double *x, const double *y, double *out);
+
 /* number of outputs of a state for nb blades */
 #define RR_N_OUT(nb) (RR_OUT_BLADE_BLOCKS * (nb) + RR_OUT_GLOBALS)
 
