@@ -136,9 +136,13 @@ static int rr_reduce_pio2(double x, double *hi, double *lo)
     k = rr_nearest(x * RR_TWO_OVER_PI);
     rr_two_prod(k, RR_PIO2_1, &p1, &e1);
     rr_two_prod(k, RR_PIO2_2, &p2, &e2);
+    /* r = x - p1 - e1 - p2 - e2 - k PIO2_3: the large terms through exact sums, only the small ones rounded */
     rr_two_sum(x, -p1, &h, &l);
+    rr_two_sum(h, -e1, &h, &t);
+    l += t;
     rr_two_sum(h, -p2, &h, &t);
-    l = ((l + t) - e1) - (e2 + k * RR_PIO2_3);
+    l += t;
+    l -= e2 + k * RR_PIO2_3;
     rr_two_sum(h, l, hi, lo);
     q = k - 4.0 * rr_floor(k * 0.25); /* 0, 1, 2 or 3 */
     return (int)q;
@@ -290,8 +294,10 @@ static double rr_tanh(double x)
     if (a > 22.0) return x > 0.0 ? 1.0 : -1.0; /* 1 - tanh(22) < 2^-60 */
     if (a < 3.725290298461914e-09) return x;  /* 2^-28: tanh x = x to the last bit */
     if (a < 0.55) {
-        double e = rr_expm1_medium(2.0 * a);
-        t = e / (e + 2.0);
+        double e = rr_expm1_medium(2.0 * a), d, err;
+        rr_two_sum(e, 2.0, &d, &err); /* e + 2 = d + err exactly: the division then sees no rounding of it */
+        t = e / d;
+        t = t - t * (err / d);
     } else {
         t = 1.0 - 2.0 / (rr_exp(2.0 * a) + 1.0); /* >= 0.5: the subtraction loses nothing */
     }
