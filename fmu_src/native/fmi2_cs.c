@@ -1,5 +1,5 @@
 /*
- * fmi2_cs.c: the FMI 2.0 co-simulation interface around a model (model.h), model-agnostic.
+ * fmi2_cs.c: the FMI 2.0 co-simulation interface around a model (fmu_model.h), model-agnostic.
  *
  * What a system simulator can rely on:
  *   - every misuse is fmi2Error with a logged message that names the variable, the value and
@@ -23,7 +23,7 @@
 #include <string.h>
 
 #include "fmi2Functions.h"
-#include "model.h"
+#include "fmu_model.h"
 
 typedef enum { PH_INSTANTIATED, PH_INITIALIZATION, PH_STEP, PH_TERMINATED } phase_t;
 static const char *PHASE_NAME[] = {"instantiated", "initialization mode", "step mode", "terminated"};

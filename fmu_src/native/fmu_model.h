@@ -1,6 +1,6 @@
 /*
- * model.h: the contract between the FMI 2.0 co-simulation wrapper (fmi2_cs.c) and a model
- * (model.c, RotorCasingContact), and the data `rotorub build-fmu --native` generates into
+ * fmu_model.h: the contract between the FMI 2.0 co-simulation wrapper (fmi2_cs.c) and a model
+ * (contact_model.c, RotorCasingContact), and the data `rotorub build-fmu --native` generates into
  * model_data.c from the parameter file and fmu_src/interface.py.
  *
  * The wrapper owns the variable values (one slot per value reference in each of a Real, an
@@ -71,7 +71,7 @@ typedef struct {
     int *i;    /* Integer, Enumeration */
 } model_values;
 
-/* ------------------------------------------------------------------ the model (model.c) */
+/* ------------------------------------------------------------------ the model (contact_model.c) */
 typedef struct model_runtime model_runtime;
 
 /* Build the runtime from the parameters in v; NULL with the reason in msg on error. */

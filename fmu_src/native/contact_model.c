@@ -1,5 +1,5 @@
 /*
- * model.c: RotorCasingContact in C, around the rotorub kernel. The same steps as the pythonfmu
+ * contact_model.c: RotorCasingContact in C, around the rotorub kernel. The same steps as the pythonfmu
  * slave (fmu_src/pythonfmu/rotorub_casing_contact.py) and the library, in the same order of operations,
  * so that the three give the same numbers:
  *
@@ -14,7 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "model.h"
+#include "fmu_model.h"
 
 #define RE_TOL 1e-6 /* a real part below this is a neutral mode's round-off (rotorub_model.analyses.stability) */
 #define STATE_TAG 52170301.0
