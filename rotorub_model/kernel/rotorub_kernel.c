@@ -748,8 +748,10 @@ static int hqr(int n, double *a, double *wr, double *wi)
                     }
                     nn -= 2;
                 } else { /* no root yet: a double-shift QR sweep on rows/columns l..nn */
-                    if (its == 30) return -1;
-                    if (its == 10 || its == 20) { /* exceptional shift */
+                    /* LAPACK's dlahqr allows 30 max(10, n) sweeps per eigenvalue with an exceptional shift every
+                     * 10; the first 30 are those of the classic hqr (which stops there and failed on rare matrices) */
+                    if (its == 30 * (n > 10 ? n : 10)) return -1;
+                    if (its > 0 && its % 10 == 0) { /* exceptional shift */
                         t += x;
                         for (i = 0; i <= nn; ++i) AH(i, i) -= x;
                         s = fabs(AH(nn, nn - 1)) + fabs(AH(nn - 1, nn - 2));
