@@ -1,19 +1,22 @@
 /*
  * fmu_host.c - a minimal native (non-Python) FMI 2.0 co-simulation master.
  *
- * It loads an *extracted* FMU's shared library with dlopen, drives one instance through
+ * It loads an *extracted* FMU's shared library (dlopen; LoadLibrary when built for Windows), drives one
+ * instance through
  * the FMI 2.0 co-simulation calling sequence and prints a CSV of the selected outputs.
  * Written for fmus/RotorCasingContact.fmu (a pythonfmu FMU, see docs/FMU-hosts.md) but
  * generic: value references come from the command line, nothing is model specific.
  *
- *   gcc -O2 -Wall -o fmu_host fmu_host.c -ldl
+ *   gcc -O2 -Wall -o fmu_host fmu_host.c -ldl     (any C99 compiler; `zig cc -target x86_64-windows-gnu`
+ *                                                 builds the win64 host that runs the win64 binary under wine)
  *
- *   fmu_host -d DIR [-m MODEL] [-L LIBPYTHON] [-n STEPS] [-s STEP] [-t START] [-q]
+ *   fmu_host -d DIR [-m MODEL] [-P PLATFORM] [-L LIBPYTHON] [-n STEPS] [-s STEP] [-t START] [-q]
  *            [-p VR=REAL]... [-I VR=INT]... [-S VR=STRING]... [-u VR=V0[:V1]]... [-e K:VR=REAL]...
  *            [-o VR]... [-i VR]...
  *
  *   -d DIR        folder the .fmu was unzipped into (holds modelDescription.xml)
- *   -m MODEL      modelIdentifier (default RotorCasingContact): binaries/linux64/MODEL.so
+ *   -m MODEL      modelIdentifier (default RotorCasingContact): binaries/PLATFORM/MODEL.so (.dll, .dylib)
+ *   -P PLATFORM   the binaries/ folder (default: the platform the host is built for, e.g. linux64)
  *   -L LIBPYTHON  dlopen this library with RTLD_GLOBAL before the FMU (a pythonfmu FMU does
  *                 not link libpython; the alternative is LD_PRELOAD=LIBPYTHON)
  *   -n STEPS      number of communication steps (default 10)
@@ -38,7 +41,7 @@
  * round-trip exactly). Log messages go to stderr as "[log] <instance> <status> <category>: msg".
  *
  * Environment: FMU_HOST_NO_FINALIZE=1 skips the call of the FMU's finalizePythonInterpreter() before exit (see
- * unload(); only there to demonstrate why the call is needed).
+ * fmi2_unload() in fmi2_host.h; only there to demonstrate why the call is needed).
  *
  * A step that does not return fmi2OK/fmi2Warning ends the run: the host reports it on stderr,
  * calls fmi2Terminate (after fmi2Discard) and fmi2FreeInstance, and exits with status 3
@@ -46,99 +49,14 @@
  * instantiated or initialized; 2: bad command line.
  */
 
-#define _GNU_SOURCE
-#include <dlfcn.h>
+#ifndef _WIN32
+#define _POSIX_C_SOURCE 200809L
+#endif
 #include <math.h>
-#include <stdarg.h>
-#include <stddef.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <time.h>
 
-/* ---------------------------------------------------------------- FMI 2.0 declarations
- * The subset of fmi2TypesPlatform.h / fmi2FunctionTypes.h this host uses (FMI 2.0 standard,
- * default platform types). */
-typedef void *fmi2Component;
-typedef void *fmi2ComponentEnvironment;
-typedef unsigned int fmi2ValueReference;
-typedef double fmi2Real;
-typedef int fmi2Integer;
-typedef int fmi2Boolean;
-typedef const char *fmi2String;
-#define fmi2True 1
-#define fmi2False 0
+#include "fmi2_host.h"
 
-typedef enum { fmi2OK, fmi2Warning, fmi2Discard, fmi2Error, fmi2Fatal, fmi2Pending } fmi2Status;
-typedef enum { fmi2ModelExchange, fmi2CoSimulation } fmi2Type;
-
-typedef void (*fmi2CallbackLogger)(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, ...);
-typedef void *(*fmi2CallbackAllocateMemory)(size_t, size_t);
-typedef void (*fmi2CallbackFreeMemory)(void *);
-typedef void (*fmi2StepFinished)(fmi2ComponentEnvironment, fmi2Status);
-
-typedef struct {
-    const fmi2CallbackLogger logger;
-    const fmi2CallbackAllocateMemory allocateMemory;
-    const fmi2CallbackFreeMemory freeMemory;
-    const fmi2StepFinished stepFinished;
-    const fmi2ComponentEnvironment componentEnvironment;
-} fmi2CallbackFunctions;
-
-typedef const char *(*fmi2GetVersionTYPE)(void);
-typedef fmi2Component (*fmi2InstantiateTYPE)(fmi2String, fmi2Type, fmi2String, fmi2String,
-                                             const fmi2CallbackFunctions *, fmi2Boolean, fmi2Boolean);
-typedef void (*fmi2FreeInstanceTYPE)(fmi2Component);
-typedef fmi2Status (*fmi2SetupExperimentTYPE)(fmi2Component, fmi2Boolean, fmi2Real, fmi2Real, fmi2Boolean, fmi2Real);
-typedef fmi2Status (*fmi2EnterInitializationModeTYPE)(fmi2Component);
-typedef fmi2Status (*fmi2ExitInitializationModeTYPE)(fmi2Component);
-typedef fmi2Status (*fmi2TerminateTYPE)(fmi2Component);
-typedef fmi2Status (*fmi2SetRealTYPE)(fmi2Component, const fmi2ValueReference[], size_t, const fmi2Real[]);
-typedef fmi2Status (*fmi2SetStringTYPE)(fmi2Component, const fmi2ValueReference[], size_t, const fmi2String[]);
-typedef fmi2Status (*fmi2SetIntegerTYPE)(fmi2Component, const fmi2ValueReference[], size_t, const fmi2Integer[]);
-typedef fmi2Status (*fmi2GetRealTYPE)(fmi2Component, const fmi2ValueReference[], size_t, fmi2Real[]);
-typedef fmi2Status (*fmi2GetIntegerTYPE)(fmi2Component, const fmi2ValueReference[], size_t, fmi2Integer[]);
-typedef fmi2Status (*fmi2DoStepTYPE)(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean);
-
-static struct {
-    fmi2GetVersionTYPE GetVersion;
-    fmi2InstantiateTYPE Instantiate;
-    fmi2FreeInstanceTYPE FreeInstance;
-    fmi2SetupExperimentTYPE SetupExperiment;
-    fmi2EnterInitializationModeTYPE EnterInitializationMode;
-    fmi2ExitInitializationModeTYPE ExitInitializationMode;
-    fmi2TerminateTYPE Terminate;
-    fmi2SetRealTYPE SetReal;
-    fmi2SetStringTYPE SetString;
-    fmi2SetIntegerTYPE SetInteger;
-    fmi2GetRealTYPE GetReal;
-    fmi2GetIntegerTYPE GetInteger;
-    fmi2DoStepTYPE DoStep;
-} fmi;
-
-static const char *status_name(fmi2Status s)
-{
-    static const char *names[] = {"fmi2OK", "fmi2Warning", "fmi2Discard", "fmi2Error", "fmi2Fatal", "fmi2Pending"};
-    return (s >= fmi2OK && s <= fmi2Pending) ? names[s] : "fmi2Status(?)";
-}
-
-/* ---------------------------------------------------------------- callbacks */
-static void logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2Status status, fmi2String category,
-                   fmi2String message, ...)
-{
-    (void)env;
-    va_list ap;
-    fprintf(stderr, "[log] %s %s %s: ", instance ? instance : "?", status_name(status), category ? category : "");
-    va_start(ap, message);
-    vfprintf(stderr, message ? message : "(null)", ap);
-    va_end(ap);
-    fputc('\n', stderr);
-    fflush(stderr);
-}
-
-static void *alloc_memory(size_t n, size_t size) { return calloc(n, size); }
-
-static const fmi2CallbackFunctions callbacks = {logger, alloc_memory, free, NULL, NULL};
+static fmi2_lib fmi;
 
 /* ---------------------------------------------------------------- command line */
 #define MAX_VARS 256
@@ -149,7 +67,7 @@ typedef struct { fmi2ValueReference vr; const char *value; } StrParam;
 
 static void usage(const char *msg)
 {
-    fprintf(stderr, "fmu_host: %s\nusage: fmu_host -d DIR [-m MODEL] [-L LIBPYTHON] [-n STEPS] [-s STEP] [-t START] "
+    fprintf(stderr, "fmu_host: %s\nusage: fmu_host -d DIR [-m MODEL] [-P PLATFORM] [-L LIBPYTHON] [-n STEPS] [-s STEP] [-t START] "
                     "[-q] [-b] [-p VR=REAL]... [-I VR=INT]... [-S VR=STRING]... [-u VR=V0[:V1]]... [-e K:VR=REAL]... [-o VR]... "
                     "[-i VR]...\n",
             msg);
@@ -191,76 +109,15 @@ static fmi2ValueReference parse_vr_assign(char *arg, char **rest, const char *op
     return (fmi2ValueReference)parse_long(arg, opt);
 }
 
-/* ---------------------------------------------------------------- helpers */
-static char *read_file(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *buf = malloc((size_t)n + 1);
-    if (buf && fread(buf, 1, (size_t)n, f) != (size_t)n) {
-        free(buf);
-        buf = NULL;
-    }
-    if (buf) buf[n] = '\0';
-    fclose(f);
-    return buf;
-}
-
-/* the guid="..." attribute of <fmiModelDescription> (first occurrence in the file) */
-static char *read_guid(const char *dir)
-{
-    char path[4096];
-    snprintf(path, sizeof path, "%s/modelDescription.xml", dir);
-    char *xml = read_file(path);
-    if (!xml) return NULL;
-    char *p = strstr(xml, " guid=\"");
-    char *guid = NULL;
-    if (p) {
-        p += 7;
-        char *q = strchr(p, '"');
-        if (q) guid = strndup(p, (size_t)(q - p));
-    }
-    free(xml);
-    return guid;
-}
-
-static void *resolve(void *lib, const char *name)
-{
-    void *f = dlsym(lib, name);
-    if (!f) {
-        fprintf(stderr, "fmu_host: the FMU does not export %s (%s)\n", name, dlerror());
-        exit(1);
-    }
-    return f;
-}
-
-static fmi2Status worst(fmi2Status a, fmi2Status b) { return a > b ? a : b; }
-
-/* The end of the FMU library's use, on every path after it was loaded.
- * pythonfmu FMUs export finalizePythonInterpreter(). Without that call the interpreter they started is finalized
- * by an exit-time destructor of the FMU library, which runs after the exit-time destructors of the libraries
- * loaded after it (the C/C++ extension modules of scipy, numba/llvmlite, ...): Py_Finalize then crashes
- * intermittently with this FMU (heap corruption, SIGSEGV after the results are written). Finalizing here, while
- * everything is intact, avoids it. Call it once, after the last fmi2FreeInstance of every pythonfmu FMU of the
- * process: the interpreter cannot be restarted (numpy cannot be imported twice). No-op for other FMUs. */
-static void unload(void *lib)
-{
-    void (*finalize_python)(void) = (void (*)(void))dlsym(lib, "finalizePythonInterpreter");
-    if (finalize_python && !getenv("FMU_HOST_NO_FINALIZE")) finalize_python();
-    if (dlclose(lib) != 0) fprintf(stderr, "fmu_host: dlclose: %s\n", dlerror());
-}
-
 /* ---------------------------------------------------------------- main */
 int main(int argc, char **argv)
 {
-    const char *dir = NULL, *model = "RotorCasingContact", *libpython = NULL;
+    const char *dir = NULL, *model = "RotorCasingContact", *libpython = NULL, *platform = NULL;
     long steps = 10;
     double h = 1e-3, t0 = 0.0;
     int logging_on = fmi2True, bench = 0;
-    struct timespec ts0, ts1, ts2;
+    double ts0 = 0.0, ts1 = 0.0, ts2 = 0.0;
+    char err[8192];
     static fmi2ValueReference pr_vr[MAX_VARS], pi_vr[MAX_VARS], out_r[MAX_VARS], out_i[MAX_VARS];
     static double pr_val[MAX_VARS];
     static fmi2Integer pi_val[MAX_VARS];
@@ -288,6 +145,7 @@ int main(int argc, char **argv)
         switch (opt[1]) {
         case 'd': dir = val; break;
         case 'm': model = val; break;
+        case 'P': platform = val; break;
         case 'L': libpython = val; break;
         case 'n': steps = parse_long(val, "-n"); break;
         case 's': h = parse_double(val, "-s"); break;
@@ -334,51 +192,38 @@ int main(int argc, char **argv)
     if (!(h > 0) || !isfinite(h)) usage("-s: the step size must be finite and > 0");
 
     /* 1. libpython first, with its symbols global, then the FMU's library */
+#ifndef _WIN32
     if (libpython && !dlopen(libpython, RTLD_NOW | RTLD_GLOBAL)) {
         fprintf(stderr, "fmu_host: cannot load %s: %s\n", libpython, dlerror());
         return 1;
     }
-    char so[4096];
-    snprintf(so, sizeof so, "%s/binaries/linux64/%s.so", dir, model);
-    void *lib = dlopen(so, RTLD_NOW | RTLD_LOCAL);
-    if (!lib) {
-        fprintf(stderr, "fmu_host: cannot load %s: %s\n", so, dlerror());
+#else
+    if (libpython) usage("-L: not on Windows (load the FMU's Python DLLs through PATH)");
+#endif
+    if (fmi2_load(&fmi, dir, model, platform, err, sizeof err) != 0) {
+        fprintf(stderr, "fmu_host: %s\n", err);
         fprintf(stderr, "fmu_host: hint: a pythonfmu FMU needs libpython3.X.so loaded first "
                         "(LD_PRELOAD=/path/to/libpython3.X.so or -L /path/to/libpython3.X.so)\n");
+        fmi2_unload(&fmi);
         return 1;
     }
-    fmi.GetVersion = (fmi2GetVersionTYPE)resolve(lib, "fmi2GetVersion");
-    fmi.Instantiate = (fmi2InstantiateTYPE)resolve(lib, "fmi2Instantiate");
-    fmi.FreeInstance = (fmi2FreeInstanceTYPE)resolve(lib, "fmi2FreeInstance");
-    fmi.SetupExperiment = (fmi2SetupExperimentTYPE)resolve(lib, "fmi2SetupExperiment");
-    fmi.EnterInitializationMode = (fmi2EnterInitializationModeTYPE)resolve(lib, "fmi2EnterInitializationMode");
-    fmi.ExitInitializationMode = (fmi2ExitInitializationModeTYPE)resolve(lib, "fmi2ExitInitializationMode");
-    fmi.Terminate = (fmi2TerminateTYPE)resolve(lib, "fmi2Terminate");
-    fmi.SetReal = (fmi2SetRealTYPE)resolve(lib, "fmi2SetReal");
-    fmi.SetString = (fmi2SetStringTYPE)resolve(lib, "fmi2SetString");
-    fmi.SetInteger = (fmi2SetIntegerTYPE)resolve(lib, "fmi2SetInteger");
-    fmi.GetReal = (fmi2GetRealTYPE)resolve(lib, "fmi2GetReal");
-    fmi.GetInteger = (fmi2GetIntegerTYPE)resolve(lib, "fmi2GetInteger");
-    fmi.DoStep = (fmi2DoStepTYPE)resolve(lib, "fmi2DoStep");
-    fprintf(stderr, "fmu_host: loaded %s (FMI %s)\n", so, fmi.GetVersion());
+    fprintf(stderr, "fmu_host: loaded %s (FMI %s)\n", fmi.path, fmi.GetVersion());
 
     /* 2. instantiate: GUID from modelDescription.xml, resources as a file:// URI */
-    char *guid = read_guid(dir);
+    char *guid = fmi2_read_guid(dir);
     if (!guid) {
         fprintf(stderr, "fmu_host: no guid in %s/modelDescription.xml\n", dir);
         return 1;
     }
     char resources[8192];
-    size_t k = (size_t)snprintf(resources, sizeof resources, "file://");
-    for (const char *c = dir; *c && k + 4 < sizeof resources; c++) /* only ' ' is escaped (what pythonfmu decodes) */
-        k += (size_t)(*c == ' ' ? snprintf(resources + k, 4, "%%20") : snprintf(resources + k, 2, "%c", *c));
-    snprintf(resources + k, sizeof resources - k, "/resources");
+    fmi2_resource_uri(dir, resources, sizeof resources);
 
-    clock_gettime(CLOCK_MONOTONIC, &ts0);
-    fmi2Component c = fmi.Instantiate("host", fmi2CoSimulation, guid, resources, &callbacks, fmi2False, logging_on);
+    ts0 = host_now();
+    fmi2Component c = fmi.Instantiate("host", fmi2CoSimulation, guid, resources, &host_callbacks, fmi2False,
+                                      logging_on);
     if (!c) {
         fprintf(stderr, "fmu_host: fmi2Instantiate failed (see the log above)\n");
-        unload(lib);
+        fmi2_unload(&fmi);
         return 1;
     }
 
@@ -397,7 +242,7 @@ int main(int argc, char **argv)
     if (st > fmi2Warning) {
         fprintf(stderr, "fmu_host: initialization returned %s\n", status_name(st));
         if (st != fmi2Fatal) fmi.FreeInstance(c);
-        unload(lib);
+        fmi2_unload(&fmi);
         return 1;
     }
 
@@ -420,7 +265,7 @@ int main(int argc, char **argv)
             t_start = t;
             st = fmi.DoStep(c, t, h, fmi2True);
             t = t0 + (double)step * h;
-            if (step == 1) clock_gettime(CLOCK_MONOTONIC, &ts1);
+            if (step == 1) ts1 = host_now();
         }
         int readable = st <= fmi2Discard; /* outputs may be inspected after fmi2Discard */
         fmi2Status get_st = fmi2OK;
@@ -471,11 +316,10 @@ int main(int argc, char **argv)
         fflush(stdout);
     }
     fflush(stdout);
-    clock_gettime(CLOCK_MONOTONIC, &ts2);
+    ts2 = host_now();
     if (bench && steps > 1)
         fprintf(stderr, "fmu_host: bench: instantiate to end of first step %.6f s; steps 2..%ld: %.9f s per step\n",
-                (double)(ts1.tv_sec - ts0.tv_sec) + 1e-9 * (double)(ts1.tv_nsec - ts0.tv_nsec), steps,
-                ((double)(ts2.tv_sec - ts1.tv_sec) + 1e-9 * (double)(ts2.tv_nsec - ts1.tv_nsec)) / (double)(steps - 1));
+                ts1 - ts0, steps, (ts2 - ts1) / (double)(steps - 1));
 
     /* 5. shut down: fmi2Terminate is not allowed after fmi2Error/fmi2Fatal; fmi2FreeInstance is, after Error */
     if (st <= fmi2Discard) {
@@ -487,7 +331,7 @@ int main(int argc, char **argv)
     free(r);
     free(iv);
     free(guid);
-    unload(lib);
+    fmi2_unload(&fmi);
     fprintf(stderr, "fmu_host: done, exit status %d\n", exit_code);
     return exit_code;
 }
