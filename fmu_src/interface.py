@@ -13,9 +13,10 @@ the native FMU (at the fmi2Set* call) and with a refused step by the pythonfmu o
 
 from __future__ import annotations
 
+import hashlib
 import math
 import uuid
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from datetime import datetime, timezone
 from xml.etree.ElementTree import Element, SubElement, tostring
 
@@ -69,6 +70,7 @@ class Var:
     max: float | None = None
     nominal: float | None = None
     declared_type: str | None = None
+    vr: int = -1  # value reference (the same in both flavours; see variables())
 
     @property
     def settable(self) -> bool:
@@ -103,8 +105,9 @@ class Defaults:
                    max_penetration=p.contact.max_penetration, slip_velocity=p.contact.slip_velocity)
 
 
-# ranges that are modelling judgements (the descriptions say why)
-G0_RANGE = (-0.01, 0.1)
+# ranges that are modelling judgements (the descriptions say why); g0's lower end is the built-in
+# max_penetration: a deeper interference is a divergence at t = 0
+G0_MAX = 0.1
 K_R_RANGE = (1e3, 1e10)
 MU_RANGE = (0.0, 1.0)
 THETA_RANGE = (0.0, math.radians(60.0))
@@ -114,14 +117,29 @@ PENETRATION_RANGE = (1e-5, 0.05)
 SLIP_RANGE = (1e-4, 10.0)
 
 
-def variables(d: Defaults, mode: str = "transient") -> list[Var]:
-    """Every variable, in value-reference order."""
+# the default experiment (both flavours): the paper's section-6 speed and the reference imbalance held from t = 0,
+# long enough for the blades to reach the casing and settle into rubbing (tests/test_fmi_behaviour.py runs it)
+DEFAULT_SPEED = 3.3  # x omega_ref
+DEFAULT_EXPERIMENT = {"startTime": 0.0, "stopTime": 2.0, "stepSize": 1e-3}
+FLAVOURS = ("native", "pythonfmu")
+
+
+def variables(d: Defaults, mode: str = "transient", flavour: str = "native") -> list[Var]:
+    """Every variable of a flavour, in value-reference order.
+
+    Both flavours number their variables the same way, so that one FMU replaces the other without
+    touching a connection: the pythonfmu flavour's ``param_file`` (value reference 4) has no
+    counterpart in the native one, whose numbering keeps the gap.
+    """
+    if flavour not in FLAVOURS:
+        raise ValueError(f"flavour: '{flavour}' unknown; accepted: {', '.join(FLAVOURS)}")
     V: list[Var] = []
     add = V.append
     add(Var("Omega", "Real", "input", "continuous",
             "Spin speed of the rotor, held over each communication step (zero-order hold). Range: 0 to the model's "
             "validity limit (normalisation.speed_max x omega_ref of the parameter file)",
-            unit="rad/s", display_unit="rpm", start=0.0, min=0.0, max=d.omega_max, nominal=3.5 * d.omega_ref))
+            unit="rad/s", display_unit="rpm", start=DEFAULT_SPEED * d.omega_ref, min=0.0, max=d.omega_max,
+            nominal=3.5 * d.omega_ref))
     add(Var("imbalance", "Real", "input", "continuous",
             "Imbalance m*e on the fan disk (angle and disk from the parameter file), held over each step. Range: 0 to "
             "one blade's static moment about the axis (beyond, a blade is missing: not this model)",
@@ -133,13 +151,13 @@ def variables(d: Defaults, mode: str = "transient") -> list[Var]:
             "solution at the held inputs, warm-started from the last one, and its stability)",
             start=1 if mode == "transient" else 2, min=1, max=2, declared_type="Mode"))
     add(Var("param_file", "String", "parameter", "fixed",
-            "Path of a rotorub TOML parameter file; empty: the model built into the FMU (the pythonfmu FMU assembles "
-            "another file's model at initialisation, which needs scipy; the native FMU accepts only the empty "
-            "value: rebuild it with rotorub build-fmu --native --params FILE)", start=""))
+            "Path of a rotorub TOML parameter file; empty: the model built into the FMU (assembled at initialisation, "
+            "which needs scipy on the host)", start=""))
     add(Var("g0", "Real", "parameter", "tunable",
             "Nominal blade-tip clearance (negative: initial interference); tunable between communication steps. "
-            "Range: 10 mm interference (beyond any abradable liner) to 100 mm",
-            unit="m", display_unit="mm", start=d.g0, min=G0_RANGE[0], max=G0_RANGE[1], nominal=1e-3))
+            "Range: an interference as deep as max_penetration (deeper diverges at once: refused, also when "
+            "max_penetration is set smaller) to 100 mm",
+            unit="m", display_unit="mm", start=d.g0, min=-d.max_penetration, max=G0_MAX, nominal=1e-3))
     add(Var("k_r", "Real", "parameter", "fixed",
             "Normal penalty stiffness of one whole blade tip. Range: 1e3 (no force to speak of) to 1e10 N/m (the "
             "stable internal step shrinks as 1/sqrt(k_r))", unit="N/m", start=d.k_r, min=K_R_RANGE[0],
@@ -206,30 +224,48 @@ def variables(d: Defaults, mode: str = "transient") -> list[Var]:
             display_unit="ms"))
     add(Var("n_substeps", "Integer", "output", "discrete",
             "Internal steps taken in the last communication step (transient mode)"))
-    return V
+    V = [replace(v, vr=k) for k, v in enumerate(V)]
+    return [v for v in V if flavour == "pythonfmu" or v.name != "param_file"]
 
 
 def _fmt(v: float | int) -> str:
     return repr(float(v)) if isinstance(v, float) else str(v)
 
 
-def model_description(vars_: list[Var], *, guid: str | None = None, generation_tool: str, version: str,
+def guid_of(*parts: bytes | str) -> str:
+    """A GUID derived from what makes an FMU what it is (its description, model data and sources), not from
+    the build time: the same model built twice has the same GUID, any change gives another one."""
+    h = hashlib.sha256()
+    for p in parts:
+        h.update(p.encode() if isinstance(p, str) else p)
+        h.update(b"\0")
+    return "{" + str(uuid.UUID(h.hexdigest()[:32])) + "}"
+
+
+def model_description(vars_: list[Var], *, guid: str, generation_tool: str, version: str,
                       needs_execution_tool: bool, feedthrough: bool, source_files: list[str] | None = None,
-                      author: str = "rotorub developers") -> Element:
-    """The FMI 2.0 co-simulation model description of ``vars_`` (an ElementTree element).
+                      author: str = "rotorub developers", model_name: str = MODEL_NAME,
+                      model_identifier: str = MODEL_IDENTIFIER, description: str = DESCRIPTION,
+                      units: dict | None = None, enumerations: dict | None = None,
+                      default_experiment: dict | None = None) -> Element:
+    """The FMI 2.0 co-simulation model description of ``vars_`` (an ElementTree element); the contact
+    FMU's by default, any other model's (the LP spool) with its names, units and experiment.
 
     ``feedthrough``: the outputs depend directly on the inputs (the quasi_static build: its
     outputs are the algebraic solution at the current inputs); otherwise they depend on no
     input (the transient build: outputs follow the state, no algebraic loop with the spool).
     """
+    units = UNITS if units is None else units
+    enumerations = ENUMERATIONS if enumerations is None else enumerations
+    experiment = DEFAULT_EXPERIMENT if default_experiment is None else default_experiment
     root = Element("fmiModelDescription", {
-        "fmiVersion": "2.0", "modelName": MODEL_NAME, "guid": guid or "{" + str(uuid.uuid4()) + "}",
-        "description": DESCRIPTION, "author": author, "version": version, "license": "MIT",
+        "fmiVersion": "2.0", "modelName": model_name, "guid": guid,
+        "description": description, "author": author, "version": version, "license": "MIT",
         "copyright": author, "generationTool": generation_tool,
         "generationDateAndTime": datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
         "variableNamingConvention": "structured", "numberOfEventIndicators": "0"})
     cs = SubElement(root, "CoSimulation", {
-        "modelIdentifier": MODEL_IDENTIFIER, "needsExecutionTool": str(needs_execution_tool).lower(),
+        "modelIdentifier": model_identifier, "needsExecutionTool": str(needs_execution_tool).lower(),
         "canHandleVariableCommunicationStepSize": "true", "canInterpolateInputs": "false",
         "maxOutputDerivativeOrder": "0", "canRunAsynchronuously": "false",
         "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions": "true",
@@ -238,17 +274,17 @@ def model_description(vars_: list[Var], *, guid: str | None = None, generation_t
         sf = SubElement(cs, "SourceFiles")
         for f in source_files:
             SubElement(sf, "File", name=f)
-    units = SubElement(root, "UnitDefinitions")
     used = {v.unit for v in vars_ if v.unit}
-    for name, (base, displays) in UNITS.items():
+    unit_defs = SubElement(root, "UnitDefinitions")
+    for name, (base, displays) in units.items():
         if name not in used:
             continue
-        u = SubElement(units, "Unit", name=name)
+        u = SubElement(unit_defs, "Unit", name=name)
         SubElement(u, "BaseUnit", {k: str(e) for k, e in base.items()})
         for dname, factor in displays.items():
             SubElement(u, "DisplayUnit", name=dname, factor=repr(factor))
-    types = SubElement(root, "TypeDefinitions")
-    for tname, items in ENUMERATIONS.items():
+    types = SubElement(root, "TypeDefinitions") if enumerations else None
+    for tname, items in enumerations.items():
         st = SubElement(types, "SimpleType", name=tname)
         en = SubElement(st, "Enumeration")
         for k, (item, desc) in enumerate(items, start=1):
@@ -260,9 +296,10 @@ def model_description(vars_: list[Var], *, guid: str | None = None, generation_t
                       ("logStatusFatal", "Log messages with fmi2Fatal status."),
                       ("logAll", "Log all messages.")):
         SubElement(logs, "Category", name=cat, description=desc)
-    SubElement(root, "DefaultExperiment", startTime="0", stopTime="1.5", stepSize="0.001")
+    SubElement(root, "DefaultExperiment", {k: _fmt(float(v)) for k, v in experiment.items()})
     mv = SubElement(root, "ModelVariables")
-    for vr, v in enumerate(vars_):
+    for k, v in enumerate(vars_):
+        vr = v.vr if v.vr >= 0 else k
         attrs = {"name": v.name, "valueReference": str(vr), "description": v.description, "causality": v.causality,
                  "variability": v.variability}
         if v.causality == "output":

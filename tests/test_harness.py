@@ -48,3 +48,17 @@ def test_quasi_static_maps_agree_with_library_maps(fmu, ref_model, tmp_path):
         assert c["same_stability_verdict_fraction"] == 1.0
         assert c["max_real_max_rel_diff"] < 1e-9
     m.plot(tmp_path / "maps.png")
+
+
+def test_quasi_static_sweep_goes_on_past_a_diverged_point(fmu, ref_model, tmp_path):
+    """With max_penetration = 0.3 mm the deepest balanced solutions at g0 = 0 (1.5 mm at 4.0 omega_ref, the
+    contact-stiffened critical) are divergences (the FMU ends that run: fmi2Terminated); the sweep rolls back to
+    the state before each such point and goes on, so the speeds past the peak, where the penetration is
+    shallower again (0.27 mm at 4.75), are solved."""
+    speeds = np.linspace(3.0, 5.5, 11)
+    m = harness.quasi_static_maps(fmu, ref_model, speeds, np.array([0.0]), tmp_path, formulations=("2D",),
+                                  compare=False, max_penetration=0.3e-3)
+    n = m.n_contact["2D"][:, 0]
+    assert (n < 0).any(), n  # some points diverged ...
+    first_bad = int(np.argmax(n < 0))
+    assert (n[first_bad:] >= 0).any(), n  # ... and the sweep solved points after them

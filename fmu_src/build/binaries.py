@@ -47,6 +47,42 @@ def _elf(data: bytes) -> tuple[str, set[str]]:
     return {62: "x86_64", 183: "aarch64"}.get(machine, f"machine {machine}"), out
 
 
+def elf_version_needs(path: str | Path) -> dict[str, list[str]]:
+    """The symbol versions an ELF shared library needs, per library it links ({"libc.so.6": ["GLIBC_2.2.5",
+    "GLIBC_2.14"]}): read from its .gnu.version_r section, as the dynamic loader checks them. The newest
+    GLIBC_x.y there is the oldest glibc the binary loads on."""
+    data = Path(path).read_bytes()
+    if data[:4] != b"\x7fELF" or data[4] != 2:
+        raise ValueError(f"{path}: not a 64-bit ELF file")
+    e = "<" if data[5] == 1 else ">"
+    shoff, = struct.unpack_from(e + "Q", data, 40)
+    shentsize, shnum = struct.unpack_from(e + "HH", data, 58)
+    sections = [struct.unpack_from(e + "IIQQQQIIQQ", data, shoff + k * shentsize) for k in range(shnum)]
+    out: dict[str, list[str]] = {}
+    for sh in sections:
+        if sh[1] != 0x6FFFFFFE:  # SHT_GNU_verneed
+            continue
+        strtab = sections[sh[6]][4]
+        at, count = sh[4], sh[7]  # sh_info: the number of entries
+        for _ in range(count):
+            _ver, cnt, file_, aux, nxt = struct.unpack_from(e + "HHIII", data, at)
+            lib = _cstr(data, strtab + file_)
+            a = at + aux
+            for _ in range(cnt):
+                _hash, _flags, _other, name, anext = struct.unpack_from(e + "IHHII", data, a)
+                out.setdefault(lib, []).append(_cstr(data, strtab + name))
+                a += anext
+            at += nxt
+    return out
+
+
+def newest_glibc(path: str | Path) -> tuple[int, ...]:
+    """The newest GLIBC_x.y version a Linux binary needs (the oldest glibc it loads on); () if none."""
+    versions = [tuple(int(x) for x in v.split("_", 1)[1].split("."))
+                for vs in elf_version_needs(path).values() for v in vs if v.startswith("GLIBC_2")]
+    return max(versions, default=())
+
+
 def _pe(data: bytes) -> tuple[str, set[str]]:
     pe, = struct.unpack_from("<I", data, 0x3C)
     machine, nsec, _t, _p, _n, optsize = struct.unpack_from("<HHIIIH", data, pe + 4)

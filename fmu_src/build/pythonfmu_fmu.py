@@ -206,12 +206,13 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
     h.update(pythonfmu_version.encode())
     h.update(mode.encode())
     tag = h.hexdigest()[:10]
+    guid = interface.guid_of("pythonfmu", h.hexdigest())  # from everything the FMU carries, not the build time
     lib_name = f"rotorub_model_{tag}"
     module_name = f"rotorub_casing_contact_{tag}"
     interface_name = f"rotorub_fmu_interface_{tag}"
     manifest = {"library": lib_name, "library_version": lib_version, "parameters": "reference.toml",
                 "model": "model.npz", "interface": interface_name, "mode": mode,
-                "feedthrough": mode == "quasi_static", "n_blades": params.blades.count, "build": tag,
+                "feedthrough": mode == "quasi_static", "n_blades": params.blades.count, "build": tag, "guid": guid,
                 "pythonfmu": pythonfmu_version, "host_requirements": HOST_REQUIREMENTS,
                 "optional_requirements": OPTIONAL_REQUIREMENTS}
 
@@ -242,7 +243,7 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
         script = stage / f"{module_name}.py"
         shutil.copy2(SCRIPT, script)
         _documentation(Path(tmp) / "documentation",
-                       interface.variables(interface.Defaults.from_parameters(params), mode))
+                       interface.variables(interface.Defaults.from_parameters(params), mode, flavour="pythonfmu"))
         out_file = dest / f"{MODEL_IDENTIFIER}.fmu"
         try:
             FmuBuilder.build_FMU(
@@ -264,7 +265,7 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
     with zipfile.ZipFile(out_file) as z:
         names = z.namelist()
         md = z.read("modelDescription.xml").decode()
-    return {"fmu": str(out_file), "size_bytes": out_file.stat().st_size, "files": len(names),
+    return {"fmu": str(out_file), "guid": guid, "size_bytes": out_file.stat().st_size, "files": len(names),
             "variables": md.count("<ScalarVariable"), "blades": params.blades.count, "build": tag,
             "parameters": str(params_path), "host_requirements": HOST_REQUIREMENTS,
             "kernel_platforms": manifest["kernel_platforms"], "exit_double_release_patched": exit_patch}

@@ -106,8 +106,10 @@ class QuasiStaticMaps:
 
 
 def quasi_static_maps(fmu: str | Path, model, speeds: np.ndarray, g0s: np.ndarray, workdir: str | Path,
-                      formulations=("2D", "3D"), compare: bool = True, progress: bool = False) -> QuasiStaticMaps:
-    """For each g0, one FMU instance in quasi_static mode swept through ``speeds`` (normalised)."""
+                      formulations=("2D", "3D"), compare: bool = True, progress: bool = False,
+                      **start) -> QuasiStaticMaps:
+    """For each g0, one FMU instance in quasi_static mode swept through ``speeds`` (normalised); ``start``:
+    other parameters' values (e.g. max_penetration)."""
     w_ref = model.params.normalisation.omega_ref
     me = model.params.imbalance.me
     unzip = _extract(fmu, Path(workdir) / "unzipped")
@@ -119,17 +121,22 @@ def quasi_static_maps(fmu: str | Path, model, speeds: np.ndarray, g0s: np.ndarra
         re = np.full((len(speeds), len(g0s)), np.nan)
         for j, g0 in enumerate(g0s):
             with Slave(fmu, instance_name=f"qs_{f}_{j}", unzip_dir=unzip, mode="quasi_static", formulation=f,
-                       g0=float(g0), Omega=float(speeds[0] * w_ref), imbalance=me) as s:
+                       g0=float(g0), Omega=float(speeds[0] * w_ref), imbalance=me, **start) as s:
                 for i, sp in enumerate(speeds):
+                    # a point without a balanced solution ends the FMU's run (fmi2Terminated): the sweep rolls
+                    # back to the state before it and goes on, as a master that handles fmi2Discard does
+                    before = s.get_state()
                     s.set(Omega=float(sp * w_ref))
                     try:
                         s.step(None, 1.0)  # from the FMU's time: a refused step does not advance it
                     except Exception:  # noqa: BLE001 - no balanced solution here: the cell stays -1
                         if s.get("status") != 1:
                             raise
+                        s.set_state(before)
                     else:
                         n[i, j] = s.get("n_contact")
                         re[i, j] = s.get("max_real_eig")
+                    s.free_state(before)
                     if bar is not None:
                         bar.update(1)
         ncon[f], mre[f] = n, re

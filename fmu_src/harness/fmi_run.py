@@ -206,6 +206,18 @@ class Slave:
                    communicationStepSize=h)
         self.time = t + h
 
+    def terminated(self) -> bool:
+        """fmi2GetBooleanStatus(fmi2Terminated): the FMU ended the run (after a divergence)."""
+        from fmpy.fmi2 import fmi2Terminated
+
+        return bool(self._call("fmi2GetBooleanStatus", self.fmu.getBooleanStatus, fmi2Terminated))
+
+    def last_successful_time(self) -> float:
+        """fmi2GetRealStatus(fmi2LastSuccessfulTime)."""
+        from fmpy.fmi2 import fmi2LastSuccessfulTime
+
+        return float(self._call("fmi2GetRealStatus", self.fmu.getRealStatus, fmi2LastSuccessfulTime))
+
     # -- rollback
     def get_state(self):
         return self._call("fmi2GetFMUstate", self.fmu.getFMUState), self.time

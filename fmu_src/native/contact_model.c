@@ -14,7 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fmu_model.h"
+#include "contact_model.h"
+#include "rr_math.h"
 
 #define RE_TOL 1e-6 /* a real part below this is a neutral mode's round-off (rotorub_model.analyses.stability) */
 #define STATE_TAG 52170301.0
@@ -87,13 +88,13 @@ static double critical_step(model_runtime *m, double w)
         }
     if (rr_eigenvalues(n, P, m->wr, m->wi, m->ework) != 0) return -1.0;
     for (i = 0; i < n; ++i) {
-        double a = hypot(m->wr[i], m->wi[i]);
+        double a = rr_sqrt(m->wr[i] * m->wr[i] + m->wi[i] * m->wi[i]);
         if (a > big) big = a;
     }
-    return 2.0 / sqrt(big);
+    return 2.0 / rr_sqrt(big);
 }
 
-model_runtime *model_configure(const model_values *v, char *msg, size_t len)
+model_runtime *model_configure(const model_values *v, double t0, char *msg, size_t len)
 {
     const model_data *d = &MODEL_DATA;
     model_runtime *m;
@@ -101,6 +102,12 @@ model_runtime *model_configure(const model_values *v, char *msg, size_t len)
     int n = d->n, nb = d->nb, np, P;
     size_t nn = (size_t)n * n, off = 0;
     double *g;
+    (void)t0; /* the contact model is autonomous: its state does not depend on the start time */
+    if (v->r[VR_G0] < -v->r[VR_MAX_PEN]) {
+        snprintf(msg, len, "g0 = %.6g mm: an interference deeper than max_penetration = %.6g mm; the run would "
+                 "diverge at t = 0 (accepted: g0 >= -max_penetration)", v->r[VR_G0] * 1e3, v->r[VR_MAX_PEN] * 1e3);
+        return NULL;
+    }
     m = (model_runtime *)zalloc(1, sizeof *m);
     if (!m) {
         snprintf(msg, len, "out of memory");
@@ -254,7 +261,7 @@ static void finish_outputs(model_values *v, double max_real)
 /* substeps of a step h at spin speed w: the step limit is evaluated once per whole rad/s */
 static int substeps(model_runtime *m, double w, double h, char *msg, size_t len)
 {
-    double band = ceil(w), cap;
+    double band = rr_ceil(w), cap;
     if (m->have_plan && m->plan_h == h && m->plan_band == band) return m->plan_n;
     if (!m->have_lim || m->lim_band != band) {
         double lim = critical_step(m, band);
@@ -267,7 +274,7 @@ static int substeps(model_runtime *m, double w, double h, char *msg, size_t len)
         m->have_lim = 1;
     }
     cap = m->dt_max < 0.5 * m->lim ? m->dt_max : 0.5 * m->lim;
-    m->plan_n = (int)ceil(h / cap * (1.0 - 1e-9));
+    m->plan_n = (int)rr_ceil(h / cap * (1.0 - 1e-9));
     if (m->plan_n < 1) m->plan_n = 1;
     m->plan_h = h;
     m->plan_band = band;
@@ -283,8 +290,7 @@ static fmi2Status transient_step(model_runtime *m, model_values *v, double w, do
     double dt;
     size_t k, nn = (size_t)n * n;
     if (m->st.diverged) {
-        snprintf(msg, len, "the run diverged at t = %.6g s (internal time); roll back with fmi2SetFMUstate or reset "
-                 "the FMU", m->st.t);
+        snprintf(msg, len, "the run diverged at t = %.6g s (internal time)", m->st.t);
         return fmi2Discard;
     }
     ns = substeps(m, w, h, msg, len);
@@ -326,7 +332,7 @@ static fmi2Status transient_step(model_runtime *m, model_values *v, double w, do
     if (done < ns) {
         snprintf(msg, len, "the run diverged at t = %.6g s (internal time): a blade penetrated the casing deeper "
                  "than max_penetration = %g mm (or the state stopped being finite); the outputs are those of that "
-                 "state; roll back with fmi2SetFMUstate or reset", m->st.t, m->max_pen * 1e3);
+                 "state", m->st.t, m->max_pen * 1e3);
         return fmi2Discard;
     }
     return fmi2OK;
@@ -339,7 +345,7 @@ static fmi2Status static_solution(model_runtime *m, model_values *v, double w, d
     const model_data *d = &MODEL_DATA;
     int n = m->n, i, j, k, its, ok;
     size_t nn = (size_t)n * n;
-    double rel, max_real = -HUGE_VAL;
+    double rel, gmin, max_real = -HUGE_VAL;
     double *q = m->Ainv; /* the transient buffers are free in this mode: the candidate solution */
     double *J = m->K2, *A = m->Aeig, *C = m->Cm1;
     k_omega(d, w, m->Kw);
@@ -385,19 +391,41 @@ static fmi2Status static_solution(model_runtime *m, model_values *v, double w, d
     finish_outputs(v, max_real);
     v->r[VR_DT_INTERNAL] = 0.0;
     v->i[VR_N_SUBSTEPS] = 0;
-    v->i[VR_STATUS] = max_real > RE_TOL ? STATUS_UNSTABLE : STATUS_OK;
+    /* the physical scale of a transient applies here too: a balanced solution that needs a deeper
+     * penetration than max_penetration is no solution of this model (the blade cuts the case) */
+    gmin = v->r[OUTPUT_INDEX[RR_OUT_BLADE_BLOCKS * m->nb + RR_OUT_GAP_MIN]];
+    if (gmin < -m->max_pen) {
+        v->i[MODEL_INFO.vr_status] = STATUS_DIVERGED;
+        snprintf(msg, len, "the balanced solution at Omega = %g rad/s, imbalance = %g kg.m, g0 = %g mm penetrates "
+                 "the casing by %.4g mm, deeper than max_penetration = %g mm: a divergence (the outputs are that "
+                 "solution's)", w, me, m->g0 * 1e3, -gmin * 1e3, m->max_pen * 1e3);
+        return fmi2Discard;
+    }
+    v->i[MODEL_INFO.vr_status] = max_real > RE_TOL ? STATUS_UNSTABLE : STATUS_OK;
     return fmi2OK;
 }
 
-fmi2Status model_step(model_runtime *m, model_values *v, double h, char *msg, size_t len)
+fmi2Status model_check_set(const model_runtime *m, const model_values *v, int vr, double x, char *msg, size_t len)
+{
+    (void)v;
+    if (vr == VR_G0 && x < -m->max_pen) {
+        snprintf(msg, len, "g0 = %.6g mm: an interference deeper than max_penetration = %.6g mm is a divergence "
+                 "(accepted: g0 >= -max_penetration)", x * 1e3, m->max_pen * 1e3);
+        return fmi2Error;
+    }
+    return fmi2OK;
+}
+
+fmi2Status model_step(model_runtime *m, model_values *v, double t, double h, char *msg, size_t len)
 {
     double w = v->r[VR_OMEGA], me = v->r[VR_IMBALANCE], g0 = v->r[VR_G0];
     fmi2Status s;
+    (void)t; /* autonomous */
     m->advanced = 0.0;
     if (g0 != m->g0) set_clearance(m, g0);
     if (m->mode == MODE_TRANSIENT) {
         s = transient_step(m, v, w, me, h, msg, len);
-        if (s == fmi2OK) v->i[VR_STATUS] = STATUS_OK;
+        if (s == fmi2OK) v->i[MODEL_INFO.vr_status] = STATUS_OK;
         return s;
     }
     s = static_solution(m, v, w, me, m->phi_qs + w * h, msg, len);
@@ -408,9 +436,10 @@ fmi2Status model_step(model_runtime *m, model_values *v, double h, char *msg, si
     return s;
 }
 
-fmi2Status model_solve_now(model_runtime *m, model_values *v, char *msg, size_t len)
+fmi2Status model_solve_now(model_runtime *m, model_values *v, double t, char *msg, size_t len)
 {
     double g0 = v->r[VR_G0];
+    (void)t;
     if (g0 != m->g0) set_clearance(m, g0);
     if (m->mode != MODE_QUASI_STATIC) {
         /* the outputs of the current state (transient: they do not depend on the inputs) */

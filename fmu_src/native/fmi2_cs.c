@@ -1,20 +1,27 @@
 /*
- * fmi2_cs.c: the FMI 2.0 co-simulation interface around a model (fmu_model.h), model-agnostic.
+ * fmi2_cs.c: the FMI 2.0 co-simulation interface around a model (fmu_model.h), model-agnostic: the same
+ * file builds RotorCasingContact and LPSpool.
  *
  * What a system simulator can rely on:
- *   - every misuse is fmi2Error with a logged message that names the variable, the value and
- *     the accepted range or the rule (never a silent fmi2OK, never fmi2Fatal, never a crash):
- *     an unknown value reference, a type mismatch, setting an output, a fixed parameter after
- *     initialisation, a value outside its declared [min, max] or not finite (refused at the
- *     fmi2Set call, the old value kept), a communication point that is not the FMU's time,
- *     fmi2DoStep before initialisation or after fmi2Terminate, a bad or foreign FMU state;
- *   - configuration errors are reported by fmi2ExitInitializationMode (fmi2Error; the
- *     parameters can be corrected and the call repeated);
- *   - a step the model cannot complete (divergence, no balanced solution) is fmi2Discard; the
- *     instance stays usable: fmi2SetFMUstate to a saved state and a retry succeed, and
- *     fmi2GetBooleanStatus(fmi2Terminated) stays fmi2False;
- *   - errors and warnings reach the logger whether or not logging was switched on (debug
- *     messages only when it was), and the last message is in the 'message' output.
+ *   - every misuse is fmi2Error with a logged message that names the variable, the value and the
+ *     accepted range or the rule (never a silent fmi2OK, never fmi2Fatal, never a crash): an unknown
+ *     value reference, a type mismatch, setting an output, a fixed parameter after initialisation, a
+ *     value outside its declared [min, max] or not finite, or one that breaks a rule of the model
+ *     (refused at the fmi2Set call, the old value kept), a communication point that is not the FMU's
+ *     time, fmi2DoStep before initialisation or after fmi2Terminate, a bad or foreign FMU state;
+ *   - configuration errors are reported by fmi2ExitInitializationMode (fmi2Error; the parameters can
+ *     be corrected and the call repeated);
+ *   - a step the model cannot complete (a divergence, a spool that stops, no balanced solution) is
+ *     fmi2Discard with the reason in the log and in 'message'; from then on
+ *     fmi2GetBooleanStatus(fmi2Terminated) is fmi2True and fmi2GetRealStatus(fmi2LastSuccessfulTime)
+ *     the time the model reached, so that every master ends the run cleanly with what it has. The flag
+ *     belongs to the FMU state: fmi2SetFMUstate to a state saved before the step (or fmi2Reset) clears
+ *     it and the run goes on; a further fmi2DoStep without that is fmi2Error;
+ *   - fmi2SetFMUstate works in every state FMI 2.0 allows it, the instantiated one included: a state
+ *     saved during a run is restored with its model (configured from the state's own parameters);
+ *   - errors and warnings reach the logger whether or not logging was switched on (debug messages only
+ *     when it was), and the last message is in the 'message' output. Numbers in messages are written as
+ *     the shortest decimal that reads back to the same double.
  */
 #include <math.h>
 #include <stdarg.h>
@@ -29,7 +36,7 @@ typedef enum { PH_INSTANTIATED, PH_INITIALIZATION, PH_STEP, PH_TERMINATED } phas
 static const char *PHASE_NAME[] = {"instantiated", "initialization mode", "step mode", "terminated"};
 
 #define MSG_LEN 1024
-#define STATE_MAGIC 0x52524655u /* "RRFU" */
+#define STATE_MAGIC 0x52524632u /* "RRF2" */
 
 typedef struct {
     char *name;
@@ -40,11 +47,12 @@ typedef struct {
     double last_good;
     double *r;
     int *i;
-    char *param_file;
     char message[MSG_LEN];
+    int stopped; /* the model ended the run (a discarded step): fmi2Terminated */
+    char stop_reason[MSG_LEN];
     model_values v;
     model_runtime *m;
-    int inputs_changed; /* quasi-static feedthrough: outputs to recompute before a read */
+    int inputs_changed; /* feedthrough: outputs to recompute before a read */
 } inst_t;
 
 typedef struct {
@@ -55,9 +63,25 @@ typedef struct {
     double *r;
     int *i;
     char message[MSG_LEN];
+    int stopped;
+    char stop_reason[MSG_LEN];
     size_t n_model;
     double *model;
 } snapshot_t;
+
+#define N_VARS ((size_t)MODEL_INFO.n_vars)
+#define VAR(vr) (&MODEL_INFO.vars[vr])
+
+/* the shortest decimal that reads back as x (%.17g writes 640.8 as 640.79999999999995) */
+static const char *num(double x, char *buf, size_t len)
+{
+    int p;
+    for (p = 1; p <= 17; ++p) {
+        snprintf(buf, len, "%.*g", p, x);
+        if (strtod(buf, NULL) == x) break;
+    }
+    return buf;
+}
 
 /* ------------------------------------------------------------------ logging and errors */
 
@@ -88,7 +112,7 @@ static void logv(inst_t *c, fmi2Status status, const char *category, const char 
 static fmi2Status fail(inst_t *c, fmi2Status status, const char *fmt, ...)
 {
     va_list ap;
-    if (status == fmi2Error) c->i[VR_STATUS] = STATUS_BAD_INPUT;
+    if (status == fmi2Error) c->i[MODEL_INFO.vr_status] = STATUS_BAD_INPUT;
     va_start(ap, fmt);
     logv(c, status, status == fmi2Error ? "logStatusError" : "logStatusDiscard", fmt, ap);
     va_end(ap);
@@ -113,25 +137,28 @@ static void debug(inst_t *c, const char *fmt, ...)
 
 /* ------------------------------------------------------------------ values */
 
+/* the only String a model has is its 'message' output (the build refuses any other) */
 static void set_starts(inst_t *c)
 {
-    int k;
-    for (k = 0; k < MODEL_DATA.n_vars; ++k) {
-        const model_var *v = &MODEL_DATA.vars[k];
-        c->r[k] = v->type == VT_REAL ? v->start : 0.0;
-        c->i[k] = v->type == VT_INTEGER || v->type == VT_ENUM ? (int)v->start : 0;
+    size_t k;
+    for (k = 0; k < N_VARS; ++k) {
+        const model_var *v = VAR(k);
+        c->r[k] = v->name && v->type == VT_REAL ? v->start : 0.0;
+        c->i[k] = v->name && (v->type == VT_INTEGER || v->type == VT_ENUM) ? (int)v->start : 0;
     }
-    c->param_file[0] = '\0';
     c->message[0] = '\0';
+    c->stopped = 0;
+    c->stop_reason[0] = '\0';
 }
 
 static fmi2Status check_vr(inst_t *c, const char *fn, fmi2ValueReference vr, int want_real, int want_int,
                            int want_str)
 {
     const model_var *v;
-    if (vr >= (fmi2ValueReference)MODEL_DATA.n_vars)
-        return fail(c, fmi2Error, "%s: unknown value reference %u (this FMU has 0..%d)", fn, vr, MODEL_DATA.n_vars - 1);
-    v = &MODEL_DATA.vars[vr];
+    if (vr >= (fmi2ValueReference)MODEL_INFO.n_vars || !VAR(vr)->name)
+        return fail(c, fmi2Error, "%s: unknown value reference %u (not a variable of this FMU: see its "
+                    "modelDescription.xml)", fn, vr);
+    v = VAR(vr);
     if ((want_real && v->type != VT_REAL) || (want_int && v->type != VT_INTEGER && v->type != VT_ENUM) ||
         (want_str && v->type != VT_STRING)) {
         static const char *TYPE[] = {"Real", "Integer", "Enumeration", "String"};
@@ -143,7 +170,7 @@ static fmi2Status check_vr(inst_t *c, const char *fn, fmi2ValueReference vr, int
 /* may variable vr be set now? */
 static fmi2Status check_settable(inst_t *c, const char *fn, fmi2ValueReference vr)
 {
-    const model_var *v = &MODEL_DATA.vars[vr];
+    const model_var *v = VAR(vr);
     if (v->causality == VC_OUTPUT)
         return fail(c, fmi2Error, "%s: %s is an output and cannot be set", fn, v->name);
     if (c->phase == PH_TERMINATED)
@@ -156,32 +183,36 @@ static fmi2Status check_settable(inst_t *c, const char *fn, fmi2ValueReference v
 
 static fmi2Status check_range(inst_t *c, const char *fn, fmi2ValueReference vr, double x)
 {
-    const model_var *v = &MODEL_DATA.vars[vr];
+    const model_var *v = VAR(vr);
+    char bx[32], blo[32], bhi[32], msg[MSG_LEN];
     if (!isfinite(x))
-        return fail(c, fmi2Error, "%s: %s = %g is not finite; accepted range [%.17g, %.17g]", fn, v->name, x, v->min,
-                    v->max);
+        return fail(c, fmi2Error, "%s: %s = %g is not finite; accepted range [%s, %s]", fn, v->name, x,
+                    num(v->min, blo, sizeof blo), num(v->max, bhi, sizeof bhi));
     if (v->has_range && (x < v->min || x > v->max))
-        return fail(c, fmi2Error, "%s: %s = %.17g out of range; accepted range [%.17g, %.17g]", fn, v->name, x,
-                    v->min, v->max);
+        return fail(c, fmi2Error, "%s: %s = %s out of range; accepted range [%s, %s]", fn, v->name,
+                    num(x, bx, sizeof bx), num(v->min, blo, sizeof blo), num(v->max, bhi, sizeof bhi));
+    /* a rule of the model between this variable and the fixed ones, once they are fixed */
+    if (c->m && c->phase == PH_STEP && v->causality != VC_OUTPUT &&
+        model_check_set(c->m, &c->v, (int)vr, x, msg, sizeof msg) != fmi2OK)
+        return fail(c, fmi2Error, "%s: %s", fn, msg);
     return fmi2OK;
 }
 
 static void after_set(inst_t *c, fmi2ValueReference vr)
 {
-    if (MODEL_DATA.vars[vr].causality == VC_INPUT || MODEL_DATA.vars[vr].variability == VV_TUNABLE)
-        c->inputs_changed = 1;
+    if (VAR(vr)->causality == VC_INPUT || VAR(vr)->variability == VV_TUNABLE) c->inputs_changed = 1;
 }
 
-/* quasi-static feedthrough build: the outputs are the solution at the current inputs */
+/* feedthrough build: the outputs are the model's at the current inputs */
 static fmi2Status refresh_outputs(inst_t *c)
 {
     char msg[MSG_LEN];
     fmi2Status s;
-    if (!MODEL_DATA.feedthrough || !c->inputs_changed || !c->m || c->phase != PH_STEP) return fmi2OK;
+    if (!MODEL_INFO.feedthrough || !c->inputs_changed || !c->m || c->phase != PH_STEP) return fmi2OK;
     c->inputs_changed = 0;
-    s = model_solve_now(c->m, &c->v, msg, sizeof msg);
+    s = model_solve_now(c->m, &c->v, c->time, msg, sizeof msg);
     if (s != fmi2OK) {
-        c->i[VR_STATUS] = STATUS_DIVERGED;
+        c->i[MODEL_INFO.vr_status] = STATUS_DIVERGED;
         return fail(c, s, "%s", msg);
     }
     return fmi2OK;
@@ -219,7 +250,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
                               fmi2Boolean visible, fmi2Boolean loggingOn)
 {
     inst_t *c;
-    int n = MODEL_DATA.n_vars;
+    int n = MODEL_INFO.n_vars;
     (void)fmuResourceLocation;
     (void)visible;
     if (!functions || !functions->logger) return NULL; /* FMI 2.0: the logger is mandatory */
@@ -233,10 +264,10 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
                           "fmi2Instantiate: this FMU supports co-simulation only (fmuType = fmi2CoSimulation)");
         return NULL;
     }
-    if (!fmuGUID || strcmp(fmuGUID, MODEL_DATA.guid) != 0) {
+    if (!fmuGUID || strcmp(fmuGUID, MODEL_INFO.guid) != 0) {
         functions->logger(functions->componentEnvironment, instanceName, fmi2Error, "logStatusError",
                           "fmi2Instantiate: GUID '%s' is not this FMU's (%s): modelDescription.xml and the binary "
-                          "come from different builds", fmuGUID ? fmuGUID : "(null)", MODEL_DATA.guid);
+                          "come from different builds", fmuGUID ? fmuGUID : "(null)", MODEL_INFO.guid);
         return NULL;
     }
     c = (inst_t *)calloc(1, sizeof *c);
@@ -244,12 +275,10 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     c->name = (char *)malloc(strlen(instanceName) + 1);
     c->r = (double *)calloc((size_t)n, sizeof(double));
     c->i = (int *)calloc((size_t)n, sizeof(int));
-    c->param_file = (char *)calloc(1, 1);
-    if (!c->name || !c->r || !c->i || !c->param_file) {
+    if (!c->name || !c->r || !c->i) {
         free(c->name);
         free(c->r);
         free(c->i);
-        free(c->param_file);
         free(c);
         functions->logger(functions->componentEnvironment, instanceName, fmi2Error, "logStatusError",
                           "fmi2Instantiate: out of memory");
@@ -274,7 +303,6 @@ void fmi2FreeInstance(fmi2Component comp)
     free(c->name);
     free(c->r);
     free(c->i);
-    free(c->param_file);
     free(c);
 }
 
@@ -314,26 +342,19 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component comp)
     CHECK_INSTANCE(comp, "fmi2ExitInitializationMode");
     if (c->phase != PH_INITIALIZATION)
         return fail(c, fmi2Error, "fmi2ExitInitializationMode: the instance is in %s", PHASE_NAME[c->phase]);
-    if (c->param_file[0]) {
-        c->i[VR_STATUS] = STATUS_BAD_INPUT;
-        return fail(c, fmi2Error, "fmi2ExitInitializationMode: param_file = '%s': this native FMU carries its model "
-                    "built in and reads no parameter file; rebuild it with `rotorub build-fmu --native --params "
-                    "FILE`, or use the pythonfmu FMU", c->param_file);
-    }
     model_free(c->m);
-    c->m = model_configure(&c->v, msg, sizeof msg);
-    if (!c->m) {
-        c->i[VR_STATUS] = STATUS_BAD_INPUT;
-        return fail(c, fmi2Error, "fmi2ExitInitializationMode: %s", msg);
-    }
+    c->m = model_configure(&c->v, c->time, msg, sizeof msg);
+    if (!c->m) return fail(c, fmi2Error, "fmi2ExitInitializationMode: %s", msg);
     c->phase = PH_STEP;
-    c->i[VR_STATUS] = STATUS_OK;
+    c->i[MODEL_INFO.vr_status] = STATUS_OK;
     c->message[0] = '\0';
+    c->stopped = 0;
+    c->stop_reason[0] = '\0';
     c->inputs_changed = 0;
-    s = model_solve_now(c->m, &c->v, msg, sizeof msg);
+    s = model_solve_now(c->m, &c->v, c->time, msg, sizeof msg);
     if (s != fmi2OK) {
         /* quasi-static: no balanced solution at the initial inputs; the first step reports it again */
-        c->i[VR_STATUS] = STATUS_DIVERGED;
+        c->i[MODEL_INFO.vr_status] = STATUS_DIVERGED;
         fail(c, fmi2Warning, "fmi2ExitInitializationMode: %s", msg);
         return fmi2Warning;
     }
@@ -398,10 +419,9 @@ fmi2Status fmi2GetBoolean(fmi2Component comp, const fmi2ValueReference vr[], siz
     CHECK_INSTANCE(comp, "fmi2GetBoolean");
     if (nvr == 0) return fmi2OK;
     if (!vr) return fail(c, fmi2Error, "fmi2GetBoolean: NULL array");
-    if (vr[0] >= (fmi2ValueReference)MODEL_DATA.n_vars)
-        return fail(c, fmi2Error, "fmi2GetBoolean: unknown value reference %u", vr[0]);
+    if (check_vr(c, "fmi2GetBoolean", vr[0], 0, 0, 0) != fmi2OK) return fmi2Error;
     return fail(c, fmi2Error, "fmi2GetBoolean: %s is not a Boolean (this FMU has no Boolean variable)",
-                MODEL_DATA.vars[vr[0]].name);
+                VAR(vr[0])->name);
 }
 
 fmi2Status fmi2GetString(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr, fmi2String value[])
@@ -413,7 +433,7 @@ fmi2Status fmi2GetString(fmi2Component comp, const fmi2ValueReference vr[], size
     if (nvr && (!vr || !value)) return fail(c, fmi2Error, "fmi2GetString: NULL array");
     for (k = 0; k < nvr; ++k)
         if ((s = check_vr(c, "fmi2GetString", vr[k], 0, 0, 1)) != fmi2OK) return s;
-    for (k = 0; k < nvr; ++k) value[k] = (int)vr[k] == VR_PARAM_FILE ? c->param_file : c->message;
+    for (k = 0; k < nvr; ++k) value[k] = c->message;
     return fmi2OK;
 }
 
@@ -460,10 +480,9 @@ fmi2Status fmi2SetBoolean(fmi2Component comp, const fmi2ValueReference vr[], siz
     CHECK_INSTANCE(comp, "fmi2SetBoolean");
     if (nvr == 0) return fmi2OK;
     if (!vr) return fail(c, fmi2Error, "fmi2SetBoolean: NULL array");
-    if (vr[0] >= (fmi2ValueReference)MODEL_DATA.n_vars)
-        return fail(c, fmi2Error, "fmi2SetBoolean: unknown value reference %u", vr[0]);
+    if (check_vr(c, "fmi2SetBoolean", vr[0], 0, 0, 0) != fmi2OK) return fmi2Error;
     return fail(c, fmi2Error, "fmi2SetBoolean: %s is not a Boolean (this FMU has no Boolean variable)",
-                MODEL_DATA.vars[vr[0]].name);
+                VAR(vr[0])->name);
 }
 
 fmi2Status fmi2SetString(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[])
@@ -476,20 +495,9 @@ fmi2Status fmi2SetString(fmi2Component comp, const fmi2ValueReference vr[], size
     for (k = 0; k < nvr; ++k) {
         if ((s = check_vr(c, "fmi2SetString", vr[k], 0, 0, 1)) != fmi2OK) return s;
         if ((s = check_settable(c, "fmi2SetString", vr[k])) != fmi2OK) return s;
-        if (!value[k]) return fail(c, fmi2Error, "fmi2SetString: %s: NULL string", MODEL_DATA.vars[vr[k]].name);
-        if ((int)vr[k] == VR_PARAM_FILE && value[k][0])
-            return fail(c, fmi2Error, "fmi2SetString: param_file = '%s': this native FMU carries its model built in "
-                        "and reads no parameter file; rebuild it with `rotorub build-fmu --native --params FILE`, "
-                        "or use the pythonfmu FMU", value[k]);
+        if (!value[k]) return fail(c, fmi2Error, "fmi2SetString: %s: NULL string", VAR(vr[k])->name);
     }
-    for (k = 0; k < nvr; ++k) {
-        char *copy = (char *)malloc(strlen(value[k]) + 1);
-        if (!copy) return fail(c, fmi2Error, "fmi2SetString: out of memory");
-        strcpy(copy, value[k]);
-        free(c->param_file);
-        c->param_file = copy;
-    }
-    return fmi2OK;
+    return fmi2OK; /* unreachable: every String is an output, refused by check_settable */
 }
 
 /* ------------------------------------------------------------------ FMI: co-simulation */
@@ -520,7 +528,7 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component comp, const fmi2ValueRefer
 fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real h, fmi2Boolean noSetFMUStatePriorToCurrentPoint)
 {
     inst_t *c = INST(comp);
-    char msg[MSG_LEN];
+    char msg[MSG_LEN], bt[32], bc[32];
     fmi2Status s;
     double tol;
     (void)noSetFMUStatePriorToCurrentPoint;
@@ -528,13 +536,18 @@ fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real h, fmi2Boolean no
     if (c->phase != PH_STEP)
         return fail(c, fmi2Error, "fmi2DoStep: the instance is in %s (steps are taken after "
                     "fmi2ExitInitializationMode and before fmi2Terminate)", PHASE_NAME[c->phase]);
+    if (c->stopped)
+        return fail(c, fmi2Error, "fmi2DoStep: the FMU ended this simulation at t = %s s (fmi2Terminated is true): "
+                    "%s; call fmi2Terminate, or roll back with fmi2SetFMUstate to a state saved before, or "
+                    "fmi2Reset", num(c->last_good, bt, sizeof bt), c->stop_reason);
     if (!isfinite(h) || !(h > 0.0))
         return fail(c, fmi2Error, "fmi2DoStep: communicationStepSize = %g: must be finite and > 0", h);
     tol = 1e-9 * (fabs(c->time) > h ? fabs(c->time) : h);
     if (!isfinite(t) || fabs(t - c->time) > tol)
-        return fail(c, fmi2Error, "fmi2DoStep: currentCommunicationPoint = %.17g does not match the FMU's time "
-                    "%.17g (steps must follow each other; to go back, use fmi2SetFMUstate)", t, c->time);
-    s = model_step(c->m, &c->v, h, msg, sizeof msg);
+        return fail(c, fmi2Error, "fmi2DoStep: currentCommunicationPoint = %s does not match the FMU's time "
+                    "%s (steps must follow each other; to go back, use fmi2SetFMUstate)", num(t, bt, sizeof bt),
+                    num(c->time, bc, sizeof bc));
+    s = model_step(c->m, &c->v, c->time, h, msg, sizeof msg);
     c->inputs_changed = 0;
     if (s == fmi2OK) {
         c->time = c->time + h;
@@ -543,8 +556,16 @@ fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real h, fmi2Boolean no
         return fmi2OK;
     }
     c->last_good = c->time + model_time_advanced(c->m);
-    c->i[VR_STATUS] = s == fmi2Discard ? STATUS_DIVERGED : STATUS_BAD_INPUT;
-    return fail(c, s, "fmi2DoStep at t = %g s: %s", t, msg);
+    if (s == fmi2Discard) {
+        /* the model cannot go on from here: the run ends (fmi2Terminated), unless the master rolls back */
+        if (c->i[MODEL_INFO.vr_status] == STATUS_OK) c->i[MODEL_INFO.vr_status] = STATUS_DIVERGED;
+        c->stopped = 1;
+        snprintf(c->stop_reason, sizeof c->stop_reason, "%s", msg);
+        return fail(c, s, "fmi2DoStep at t = %s s: %s (fmi2Terminated = true: the run ends at the last successful "
+                    "time %s s; fmi2SetFMUstate to an earlier state to go on)", num(t, bt, sizeof bt), msg,
+                    num(c->last_good, bc, sizeof bc));
+    }
+    return fail(c, s, "fmi2DoStep at t = %s s: %s", num(t, bt, sizeof bt), msg);
 }
 
 fmi2Status fmi2CancelStep(fmi2Component comp)
@@ -581,7 +602,7 @@ fmi2Status fmi2GetBooleanStatus(fmi2Component comp, const fmi2StatusKind s, fmi2
 {
     CHECK_INSTANCE(comp, "fmi2GetBooleanStatus");
     if (s != fmi2Terminated || !value) return fmi2Discard;
-    *value = fmi2False; /* a refused step is recoverable: roll back, change the input, retry */
+    *value = INST(comp)->stopped ? fmi2True : fmi2False; /* the model ended the run (a discarded step) */
     return fmi2OK;
 }
 
@@ -608,7 +629,6 @@ fmi2Status fmi2GetFMUstate(fmi2Component comp, fmi2FMUstate *state)
 {
     inst_t *c = INST(comp);
     snapshot_t *p;
-    size_t n = (size_t)MODEL_DATA.n_vars;
     CHECK_INSTANCE(comp, "fmi2GetFMUstate");
     if (!state) return fail(c, fmi2Error, "fmi2GetFMUstate: NULL pointer");
     p = (snapshot_t *)*state;
@@ -616,8 +636,8 @@ fmi2Status fmi2GetFMUstate(fmi2Component comp, fmi2FMUstate *state)
     if (!p) {
         p = (snapshot_t *)calloc(1, sizeof *p);
         if (!p) return fail(c, fmi2Error, "fmi2GetFMUstate: out of memory");
-        p->r = (double *)calloc(n, sizeof(double));
-        p->i = (int *)calloc(n, sizeof(int));
+        p->r = (double *)calloc(N_VARS, sizeof(double));
+        p->i = (int *)calloc(N_VARS, sizeof(int));
         if (!p->r || !p->i) {
             free_snapshot(p);
             return fail(c, fmi2Error, "fmi2GetFMUstate: out of memory");
@@ -628,9 +648,11 @@ fmi2Status fmi2GetFMUstate(fmi2Component comp, fmi2FMUstate *state)
     p->phase = c->phase;
     p->time = c->time;
     p->last_good = c->last_good;
-    memcpy(p->r, c->r, n * sizeof(double));
-    memcpy(p->i, c->i, n * sizeof(int));
+    memcpy(p->r, c->r, N_VARS * sizeof(double));
+    memcpy(p->i, c->i, N_VARS * sizeof(int));
     memcpy(p->message, c->message, MSG_LEN);
+    p->stopped = c->stopped;
+    memcpy(p->stop_reason, c->stop_reason, MSG_LEN);
     free(p->model);
     p->model = NULL;
     p->n_model = c->m ? model_state_size(c->m) : 0;
@@ -647,27 +669,60 @@ fmi2Status fmi2GetFMUstate(fmi2Component comp, fmi2FMUstate *state)
     return fmi2OK;
 }
 
-/* Restore a snapshot; a state of another configuration (or no model when one is needed) is refused. */
+/* the fixed parameters of a snapshot are those this instance's model was configured with */
+static int same_configuration(const inst_t *c, const snapshot_t *p)
+{
+    size_t k;
+    for (k = 0; k < N_VARS; ++k) {
+        const model_var *v = VAR(k);
+        if (!v->name || v->causality != VC_PARAMETER || v->variability != VV_FIXED) continue;
+        if (v->type == VT_REAL ? c->r[k] != p->r[k] : c->i[k] != p->i[k]) return 0;
+    }
+    return 1;
+}
+
+/* Restore a snapshot in any phase. A state saved during a run brings its model: this instance's when it
+ * was configured with the same fixed parameters, otherwise one configured from the state's own values (a
+ * state restored right after fmi2Instantiate, as fmusim's --initial-fmu-state-file does). A state saved
+ * before initialisation leaves no model. Nothing changes when the state is refused. */
 static fmi2Status restore(inst_t *c, const snapshot_t *p, const char *fn)
 {
-    size_t n = (size_t)MODEL_DATA.n_vars;
+    char msg[MSG_LEN];
+    model_runtime *m = NULL;
+    int fresh = 0;
     if (!p || p->magic != STATE_MAGIC) return fail(c, fmi2Error, "%s: not a state of this FMU", fn);
-    if (p->phase > PH_TERMINATED) return fail(c, fmi2Error, "%s: corrupt state (phase)", fn);
+    if (p->phase > PH_TERMINATED || (p->phase == PH_STEP && !p->n_model))
+        return fail(c, fmi2Error, "%s: corrupt state (phase)", fn);
     if (p->n_model) {
-        if (!c->m)
-            return fail(c, fmi2Error, "%s: the state holds a running simulation; this instance is not initialised "
-                        "(restore after fmi2ExitInitializationMode)", fn);
-        if (p->i[VR_FORMULATION] != c->i[VR_FORMULATION] || p->i[VR_MODE] != c->i[VR_MODE] ||
-            model_state_restore(c->m, p->model, p->n_model) != 0)
-            return fail(c, fmi2Error, "%s: the state was saved with another configuration (formulation, mode or "
-                        "model) or is corrupt; nothing restored", fn);
+        if (c->m && same_configuration(c, p)) {
+            m = c->m;
+        } else {
+            model_values pv;
+            pv.r = p->r;
+            pv.i = p->i;
+            m = model_configure(&pv, p->time, msg, sizeof msg);
+            if (!m) return fail(c, fmi2Error, "%s: the state's parameters do not make a model (%s); nothing restored",
+                                fn, msg);
+            fresh = 1;
+        }
+        if (model_state_restore(m, p->model, p->n_model) != 0) {
+            if (fresh) model_free(m);
+            return fail(c, fmi2Error, "%s: the state was saved with another configuration or is corrupt; nothing "
+                        "restored", fn);
+        }
     }
-    c->phase = p->phase == PH_STEP && !c->m ? PH_INITIALIZATION : p->phase;
+    if (m != c->m) {
+        model_free(c->m);
+        c->m = m;
+    }
+    c->phase = p->phase;
     c->time = p->time;
     c->last_good = p->last_good;
-    memcpy(c->r, p->r, n * sizeof(double));
-    memcpy(c->i, p->i, n * sizeof(int));
+    memcpy(c->r, p->r, N_VARS * sizeof(double));
+    memcpy(c->i, p->i, N_VARS * sizeof(int));
     memcpy(c->message, p->message, MSG_LEN);
+    c->stopped = p->stopped;
+    memcpy(c->stop_reason, p->stop_reason, MSG_LEN);
     c->inputs_changed = 0;
     return fmi2OK;
 }
@@ -689,12 +744,13 @@ fmi2Status fmi2FreeFMUstate(fmi2Component comp, fmi2FMUstate *state)
     return fmi2OK;
 }
 
-/* serialised: magic, guid (64 bytes), phase, n_vars, n_model, time, last_good, r[], i[], message, model[] */
+/* serialised: magic, guid (64 bytes), phase, n_vars, n_model, stopped (8 bytes each), time, last_good, r[], i[],
+ * message, stop_reason, model[] */
 #define GUID_BYTES 64
-static size_t serialized_size(const snapshot_t *p)
+#define HEAD_BYTES (4 + GUID_BYTES + 4 * 8 + 2 * 8)
+static size_t serialized_size_of(size_t n_model)
 {
-    size_t n = (size_t)MODEL_DATA.n_vars;
-    return 4 + GUID_BYTES + 3 * 8 + 2 * 8 + n * 8 + n * 4 + MSG_LEN + p->n_model * 8;
+    return HEAD_BYTES + N_VARS * 8 + N_VARS * 4 + 2 * MSG_LEN + n_model * 8;
 }
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component comp, fmi2FMUstate state, size_t *size)
@@ -702,37 +758,40 @@ fmi2Status fmi2SerializedFMUstateSize(fmi2Component comp, fmi2FMUstate state, si
     CHECK_INSTANCE(comp, "fmi2SerializedFMUstateSize");
     if (!state || ((snapshot_t *)state)->magic != STATE_MAGIC || !size)
         return fail(INST(comp), fmi2Error, "fmi2SerializedFMUstateSize: not a state of this FMU");
-    *size = serialized_size((const snapshot_t *)state);
+    *size = serialized_size_of(((const snapshot_t *)state)->n_model);
     return fmi2OK;
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component comp, fmi2FMUstate state, fmi2Byte bytes[], size_t size)
 {
     const snapshot_t *p = (const snapshot_t *)state;
-    size_t n = (size_t)MODEL_DATA.n_vars, at = 0;
+    size_t at = 0;
     unsigned long long u;
     char guid[GUID_BYTES];
     CHECK_INSTANCE(comp, "fmi2SerializeFMUstate");
     if (!p || p->magic != STATE_MAGIC) return fail(INST(comp), fmi2Error, "fmi2SerializeFMUstate: not a state of this FMU");
-    if (!bytes || size != serialized_size(p))
+    if (!bytes || size != serialized_size_of(p->n_model))
         return fail(INST(comp), fmi2Error, "fmi2SerializeFMUstate: the buffer has %zu bytes, the state needs %zu", size,
-                    serialized_size(p));
+                    serialized_size_of(p->n_model));
     memset(guid, 0, sizeof guid);
-    strncpy(guid, MODEL_DATA.guid, GUID_BYTES - 1);
+    strncpy(guid, MODEL_INFO.guid, GUID_BYTES - 1);
 #define PUT(src, nbytes) (memcpy(bytes + at, (src), (nbytes)), at += (nbytes))
     PUT(&p->magic, 4);
     PUT(guid, GUID_BYTES);
     u = (unsigned long long)p->phase;
     PUT(&u, 8);
-    u = (unsigned long long)n;
+    u = (unsigned long long)N_VARS;
     PUT(&u, 8);
     u = (unsigned long long)p->n_model;
     PUT(&u, 8);
+    u = (unsigned long long)p->stopped;
+    PUT(&u, 8);
     PUT(&p->time, 8);
     PUT(&p->last_good, 8);
-    PUT(p->r, n * 8);
-    PUT(p->i, n * 4);
+    PUT(p->r, N_VARS * 8);
+    PUT(p->i, N_VARS * 4);
     PUT(p->message, MSG_LEN);
+    PUT(p->stop_reason, MSG_LEN);
     if (p->n_model) PUT(p->model, p->n_model * 8);
 #undef PUT
     return fmi2OK;
@@ -741,31 +800,31 @@ fmi2Status fmi2SerializeFMUstate(fmi2Component comp, fmi2FMUstate state, fmi2Byt
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component comp, const fmi2Byte bytes[], size_t size, fmi2FMUstate *state)
 {
     inst_t *c = INST(comp);
-    size_t n = (size_t)MODEL_DATA.n_vars, at = 0, k;
-    unsigned long long phase, nv, nm;
+    size_t at = 0, k;
+    unsigned long long phase, nv, nm, stopped;
     unsigned magic;
     char guid[GUID_BYTES];
     snapshot_t *p;
     CHECK_INSTANCE(comp, "fmi2DeSerializeFMUstate");
     if (!bytes || !state) return fail(c, fmi2Error, "fmi2DeSerializeFMUstate: NULL pointer");
-    if (size < 4 + GUID_BYTES + 5 * 8) return fail(c, fmi2Error, "fmi2DeSerializeFMUstate: %zu bytes: too short to "
-                                                   "be a state of this FMU", size);
+    if (size < HEAD_BYTES) return fail(c, fmi2Error, "fmi2DeSerializeFMUstate: %zu bytes: too short to be a state of "
+                                       "this FMU", size);
 #define GET(dst, nbytes) (memcpy((dst), bytes + at, (nbytes)), at += (nbytes))
     GET(&magic, 4);
     GET(guid, GUID_BYTES);
     guid[GUID_BYTES - 1] = '\0';
-    if (magic != STATE_MAGIC || strcmp(guid, MODEL_DATA.guid) != 0)
+    if (magic != STATE_MAGIC || strcmp(guid, MODEL_INFO.guid) != 0)
         return fail(c, fmi2Error, "fmi2DeSerializeFMUstate: not a state of this FMU (wrong magic or GUID)");
     GET(&phase, 8);
     GET(&nv, 8);
     GET(&nm, 8);
-    if (phase > PH_TERMINATED || nv != n || nm > 100000 ||
-        size != 4 + GUID_BYTES + 3 * 8 + 2 * 8 + n * 8 + n * 4 + MSG_LEN + nm * 8)
+    GET(&stopped, 8);
+    if (phase > PH_TERMINATED || nv != N_VARS || nm > 100000 || stopped > 1 || size != serialized_size_of((size_t)nm))
         return fail(c, fmi2Error, "fmi2DeSerializeFMUstate: corrupt state (sizes do not match this FMU)");
     p = (snapshot_t *)calloc(1, sizeof *p);
     if (!p) return fail(c, fmi2Error, "fmi2DeSerializeFMUstate: out of memory");
-    p->r = (double *)calloc(n, sizeof(double));
-    p->i = (int *)calloc(n, sizeof(int));
+    p->r = (double *)calloc(N_VARS, sizeof(double));
+    p->i = (int *)calloc(N_VARS, sizeof(int));
     p->model = nm ? (double *)calloc((size_t)nm, sizeof(double)) : NULL;
     if (!p->r || !p->i || (nm && !p->model)) {
         free_snapshot(p);
@@ -775,22 +834,26 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component comp, const fmi2Byte bytes[], s
     p->owner = c;
     p->phase = (phase_t)phase;
     p->n_model = (size_t)nm;
+    p->stopped = (int)stopped;
     GET(&p->time, 8);
     GET(&p->last_good, 8);
-    GET(p->r, n * 8);
-    GET(p->i, n * 4);
+    GET(p->r, N_VARS * 8);
+    GET(p->i, N_VARS * 4);
     GET(p->message, MSG_LEN);
     p->message[MSG_LEN - 1] = '\0';
+    GET(p->stop_reason, MSG_LEN);
+    p->stop_reason[MSG_LEN - 1] = '\0';
     if (nm) GET(p->model, (size_t)nm * 8);
 #undef GET
     if (!isfinite(p->time) || !isfinite(p->last_good)) {
         free_snapshot(p);
         return fail(c, fmi2Error, "fmi2DeSerializeFMUstate: corrupt state (time)");
     }
-    for (k = 0; k < n; ++k) {
-        const model_var *v = &MODEL_DATA.vars[k];
-        if ((v->type == VT_REAL && v->causality != VC_OUTPUT && check_range(c, "fmi2DeSerializeFMUstate", (unsigned)k,
-                                                                           p->r[k]) != fmi2OK) ||
+    for (k = 0; k < N_VARS; ++k) {
+        const model_var *v = VAR(k);
+        if (!v->name) continue;
+        if ((v->type == VT_REAL && v->causality != VC_OUTPUT &&
+             (!isfinite(p->r[k]) || (v->has_range && (p->r[k] < v->min || p->r[k] > v->max)))) ||
             (v->type == VT_ENUM && (p->i[k] < v->min || p->i[k] > v->max))) {
             free_snapshot(p);
             return fail(c, fmi2Error, "fmi2DeSerializeFMUstate: corrupt state (%s out of range)", v->name);

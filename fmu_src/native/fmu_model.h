@@ -1,12 +1,14 @@
 /*
- * fmu_model.h: the contract between the FMI 2.0 co-simulation wrapper (fmi2_cs.c) and a model
- * (contact_model.c, RotorCasingContact), and the data `rotorub build-fmu --native` generates into
- * model_data.c from the parameter file and fmu_src/interface.py.
+ * fmu_model.h: the contract between the FMI 2.0 co-simulation wrapper (fmi2_cs.c) and a model behind it
+ * (contact_model.c: RotorCasingContact; spool_model.c: LPSpool), as the Modelica Reference-FMUs keep one
+ * small model source behind a shared wrapper.
  *
- * The wrapper owns the variable values (one slot per value reference in each of a Real, an
- * Integer and a String array), the FMI state machine, logging and FMU-state snapshots; the
- * model owns the physics: configuration at the end of initialisation, a communication step,
- * the outputs of its state, and what a snapshot of its state holds.
+ * The wrapper owns the variable values (one slot per value reference in each of a Real and an Integer
+ * array), the FMI state machine, logging, the checks every variable has (type, causality, variability,
+ * declared range) and FMU-state snapshots; the model owns the physics: configuration at the end of
+ * initialisation, a communication step, the outputs of its state, rules that tie one variable to another,
+ * and what a snapshot of its state holds. `rotorub build-fmu --native` generates each model's variable table
+ * (MODEL_INFO) from the Python definition of its interface.
  */
 #ifndef ROTORUB_FMU_MODEL_H
 #define ROTORUB_FMU_MODEL_H
@@ -14,7 +16,6 @@
 #include <stddef.h>
 
 #include "fmi2Functions.h"
-#include "rotorub_kernel.h"
 
 /* ------------------------------------------------------------------ variables (generated table) */
 typedef enum { VT_REAL, VT_INTEGER, VT_ENUM, VT_STRING } var_type;
@@ -22,7 +23,7 @@ typedef enum { VC_INPUT, VC_PARAMETER, VC_OUTPUT } var_causality;
 typedef enum { VV_CONTINUOUS, VV_DISCRETE, VV_FIXED, VV_TUNABLE } var_variability;
 
 typedef struct {
-    const char *name;
+    const char *name;      /* NULL: no variable has this value reference (a gap in the numbering) */
     var_type type;
     var_causality causality;
     var_variability variability;
@@ -32,38 +33,20 @@ typedef struct {
     const char *start_str; /* String */
 } model_var;
 
-/* ------------------------------------------------------------------ the model's data (generated) */
 typedef struct {
     const char *guid;
-    int n_vars;
+    const char *model_identifier;
+    int n_vars;            /* value references 0 .. n_vars - 1 */
     const model_var *vars;
-    int feedthrough;       /* built for quasi_static: outputs follow the inputs without a step */
-    int n;                 /* generalised coordinates */
-    int nb;                /* blades */
-    /* structure, rotating frame: M q'' + (D + W G1) q' + (K + W^2 (S2 + N2) + W C1) q = F_nl + me W^2 f_unit */
-    const double *M, *D, *K, *G1, *C1, *N2, *S2, *f_unit;
-    /* contact geometry ingredients (rr_geometry_spec but theta, chord, np, rotations) */
-    double r_tip, stagger, z_cg;
-    int blade_dof0, n_ritz, casing_dof0, n_modes;
-    const double *psi_tip;
-    const int *modes;
-    const double *T, *Rot; /* (3, n) fan-disk translation and rotation */
-} model_data;
+    int feedthrough;       /* outputs follow the inputs without a step (model_solve_now after a set) */
+    int vr_status;         /* the Integer 'status' output */
+    int vr_message;        /* the String 'message' output */
+} model_info;
 
-extern const model_data MODEL_DATA;
+extern const model_info MODEL_INFO;
 
-/* value references the model reads and writes (fixed by fmu_src/interface.py; checked at build) */
-enum {
-    VR_OMEGA, VR_IMBALANCE, VR_FORMULATION, VR_MODE, VR_PARAM_FILE, VR_G0, VR_K_R, VR_MU, VR_THETA, VR_CHORD,
-    VR_DT_MAX, VR_MAX_PEN, VR_SLIP
-};
-extern const int VR_N_CONTACT, VR_MAX_REAL, VR_STATUS, VR_MESSAGE, VR_DT_INTERNAL, VR_N_SUBSTEPS;
-/* where the kernel's outputs of a state (its order, RR_N_OUT(nb)) go in the Real value array */
-extern const int OUTPUT_INDEX[];
-
-enum { STATUS_OK = 0, STATUS_DIVERGED = 1, STATUS_BAD_INPUT = 2, STATUS_UNSTABLE = 3 };
-enum { FORMULATION_2D = 1, FORMULATION_3D = 2 };
-enum { MODE_TRANSIENT = 1, MODE_QUASI_STATIC = 2 };
+/* the status output's codes every model shares (a model may add its own above these) */
+enum { STATUS_OK = 0, STATUS_DIVERGED = 1, STATUS_BAD_INPUT = 2 };
 
 /* The values the wrapper holds (one slot per value reference in each array). */
 typedef struct {
@@ -71,27 +54,33 @@ typedef struct {
     int *i;    /* Integer, Enumeration */
 } model_values;
 
-/* ------------------------------------------------------------------ the model (contact_model.c) */
+/* ------------------------------------------------------------------ the model */
 typedef struct model_runtime model_runtime;
 
-/* Build the runtime from the parameters in v; NULL with the reason in msg on error. */
-model_runtime *model_configure(const model_values *v, char *msg, size_t len);
+/* Build the runtime from the parameters in v (start time t0); NULL with the reason in msg if the
+ * parameters do not make a model (a rule between variables, a singular matrix, ...). */
+model_runtime *model_configure(const model_values *v, double t0, char *msg, size_t len);
 void model_free(model_runtime *m);
 
-/* One communication step [t, t + h] at the inputs held in v: fmi2OK; fmi2Discard (diverged, no
- * balanced solution) or fmi2Error (an input the step cannot take) with the reason in msg.
- * Outputs, status, dt_internal and n_substeps are written to v. */
-fmi2Status model_step(model_runtime *m, model_values *v, double h, char *msg, size_t len);
+/* A rule of the model between variables, checked when a tunable parameter or an input is set during
+ * the simulation (m configured): fmi2OK, or fmi2Error with the reason in msg (nothing is stored).
+ * Before initialisation the same rules are model_configure's. */
+fmi2Status model_check_set(const model_runtime *m, const model_values *v, int vr, double x, char *msg, size_t len);
 
-/* Quasi-static feedthrough: the balanced solution at the current inputs, without advancing time
- * (outputs written to v); fmi2OK or fmi2Discard with msg. */
-fmi2Status model_solve_now(model_runtime *m, model_values *v, char *msg, size_t len);
+/* One communication step [t, t + h] at the inputs held in v: fmi2OK; fmi2Discard (the model cannot go
+ * on: diverged, stopped, no balanced solution) or fmi2Error (an input the step cannot take) with the
+ * reason in msg. Outputs and the status output are written to v. */
+fmi2Status model_step(model_runtime *m, model_values *v, double t, double h, char *msg, size_t len);
+
+/* The outputs at time t of the current state, at the current inputs, without advancing time (after
+ * initialisation; feedthrough models after a set): fmi2OK or fmi2Discard with msg. */
+fmi2Status model_solve_now(model_runtime *m, model_values *v, double t, char *msg, size_t len);
 
 /* The time advanced by the last step (all of h, or up to the last good substep). */
 double model_time_advanced(const model_runtime *m);
 
-/* Snapshot of the state a rollback needs, as doubles: model_state_size of them. restore
- * returns 0, or -1 if the data are not a state of this configuration (nothing is changed). */
+/* Snapshot of the state a rollback needs, as doubles: model_state_size of them. restore returns 0,
+ * or -1 if the data are not a state of this configuration (nothing is changed). */
 size_t model_state_size(const model_runtime *m);
 void model_state_save(const model_runtime *m, double *out);
 int model_state_restore(model_runtime *m, const double *in, size_t n);

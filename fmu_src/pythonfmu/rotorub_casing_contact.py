@@ -33,7 +33,7 @@ from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, In
 from pythonfmu.enums import Fmi2Status
 
 MANIFEST = "rotorub_fmu.json"
-STATE_VERSION = 2
+STATE_VERSION = 3
 RE_TOL = 1e-6  # a real part below this is a neutral mode's round-off (rotorub_model.analyses.stability)
 
 # submodules of the bundled library imported eagerly: a later lazy import must not
@@ -74,7 +74,9 @@ class RotorCasingContact(Fmi2Slave):
         self.copyright = "rotorub developers"
         self._ref = self._lib.params.from_dict(self._manifest["parameter_values"])
         self._feedthrough = bool(self._manifest.get("feedthrough", False))
-        self._vars = itf.variables(itf.Defaults.from_parameters(self._ref), self._manifest.get("mode", "transient"))
+        self._vars = itf.variables(itf.Defaults.from_parameters(self._ref), self._manifest.get("mode", "transient"),
+                                   flavour="pythonfmu")
+        self.guid = self._manifest["guid"]  # derived from the model at build time, not pythonfmu's uuid1()
         n = len(self._vars)
         self._slot = {v.name: i for i, v in enumerate(self._vars)}
         self._rv = np.zeros(n)
@@ -97,12 +99,14 @@ class RotorCasingContact(Fmi2Slave):
         self._i_omega, self._i_me, self._i_g0 = s["Omega"], s["imbalance"], s["g0"]
         self._i_dt, self._i_nsub, self._i_nc = s["dt_internal"], s["n_substeps"], s["n_contact"]
         self._i_status, self._i_msg, self._i_maxre = s["status"], s["message"], s["max_real_eig"]
+        self._i_gmin = s["gap_min"]
         self._get_memo: tuple[list, np.ndarray] = ([], np.zeros(0, dtype=np.intp))
         self._phase = "instantiated"  # -> initialization -> step -> terminated
         self._t = 0.0  # the FMU's time: the end of the last step taken
         self._sim = None  # runtime objects, built at the end of initialization
         self._fatal_msg = None  # a configuration error: every step is refused until reset
         self._pending = None  # a refused fmi2Set*: the next step is refused with it
+        self._stopped = None  # (time, reason): the model ended the run (a discarded step), until a rollback
         self._stale = False  # quasi-static feedthrough: an input changed since the outputs
 
     # ------------------------------------------------------------------ variables
@@ -161,6 +165,10 @@ class RotorCasingContact(Fmi2Slave):
                 return self._refuse(f"{v.name} = {x!r} is not finite; accepted range [{v.min!r}, {v.max!r}]")
             if v.min is not None and (x < v.min or x > v.max):
                 return self._refuse(f"{v.name} = {x!r} out of range; accepted range [{v.min!r}, {v.max!r}]")
+            if i == self._i_g0 and self._sim is not None and self._phase == "step":
+                why = self._g0_rule(x, self._sim["config"]["max_penetration"])
+                if why:
+                    return self._refuse(why)
         if v.type == "Real":
             if self._rv[i] != value:
                 self._stale = True
@@ -193,7 +201,8 @@ class RotorCasingContact(Fmi2Slave):
     def set_real(self, vrs, values):
         rv, inputs = self._rv, self._real_inputs
         for vr, v in zip(vrs, values):
-            if vr in inputs and self._phase != "terminated" and self._vars[vr].min <= v <= self._vars[vr].max:
+            if (vr in inputs and self._phase != "terminated" and self._vars[vr].min <= v <= self._vars[vr].max
+                    and (vr != self._i_g0 or self._sim is None or v >= -self._sim["config"]["max_penetration"])):
                 if rv[vr] != v:  # the per-step traffic: Omega, imbalance, g0 (tunable), in range
                     self._stale = True
                 rv[vr] = v
@@ -257,6 +266,14 @@ class RotorCasingContact(Fmi2Slave):
         self.log(f"RotorCasingContact: {msg}",
                  Fmi2Status.error if status == self._if.STATUS_BAD_INPUT else Fmi2Status.discard)
 
+    @staticmethod
+    def _g0_rule(g0: float, max_penetration: float) -> str | None:
+        """The native FMU's rule between g0 and max_penetration (contact_model.c), or None."""
+        if g0 < -max_penetration:
+            return (f"g0 = {g0 * 1e3:.6g} mm: an interference deeper than max_penetration = "
+                    f"{max_penetration * 1e3:.6g} mm is a divergence (accepted: g0 >= -max_penetration)")
+        return None
+
     def _configuration_error(self, msg: str) -> None:
         self._fatal_msg = msg
         self._sim = None
@@ -286,6 +303,9 @@ class RotorCasingContact(Fmi2Slave):
                              f"outputs for {self._ref.blades.count} blades; rebuild it with "
                              f"`rotorub build-fmu --params {path}`")
         g0 = self._r("g0")
+        why = self._g0_rule(g0, cfg["max_penetration"])
+        if why:
+            raise ValueError(why + "; the run would diverge at t = 0")
         params = params.replace(contact={"g0": g0, "k_r": cfg["k_r"], "mu": cfg["mu"],
                                          "theta_deg": math.degrees(cfg["theta"]), "chord": cfg["chord"],
                                          "max_penetration": cfg["max_penetration"],
@@ -328,6 +348,11 @@ class RotorCasingContact(Fmi2Slave):
         if self._fatal_msg is not None:
             self._report(self._if.STATUS_BAD_INPUT, self._fatal_msg + " (every step is refused until the FMU is reset)")
             return False
+        if self._stopped is not None:
+            self._report(self._if.STATUS_BAD_INPUT, f"fmi2DoStep: the FMU ended this simulation at t = "
+                         f"{self._stopped[0]!r} s (fmi2Terminated is true): {self._stopped[1]}; call fmi2Terminate, "
+                         "or roll back with fmi2SetFMUstate to a state saved before, or fmi2Reset")
+            return False
         if self._pending is not None:
             msg, self._pending = self._pending, None
             self._report(self._if.STATUS_BAD_INPUT, f"at t = {t:g} s: step refused: {msg}")
@@ -345,6 +370,7 @@ class RotorCasingContact(Fmi2Slave):
         if g0 != sim["g0"]:
             sim["g0"] = g0
             self._apply_clearance(g0)
+        t_model = sim["cd"].t if sim["transient"] else 0.0
         if sim["transient"]:
             ok = self._transient(omega, me, h)
         else:
@@ -355,6 +381,9 @@ class RotorCasingContact(Fmi2Slave):
         if ok:
             self._t = self._t + h
             self._sv[self._i_msg] = ""
+        elif self._iv[self._i_status] == self._if.STATUS_DIVERGED:  # the model cannot go on: the run ends
+            reached = self._t + (sim["cd"].t - t_model if sim["transient"] else 0.0)
+            self._stopped = (reached, self._sv[self._i_msg])
         return ok
 
     def _apply_clearance(self, g0: float) -> None:
@@ -386,8 +415,7 @@ class RotorCasingContact(Fmi2Slave):
     def _transient(self, omega: float, me: float, h: float) -> bool:
         cd = self._sim["cd"]
         if cd.diverged:
-            self._report(self._if.STATUS_DIVERGED, f"the run diverged at t = {cd.t:.6g} s (internal time); roll "
-                         "back with fmi2SetFMUstate or reset the FMU")
+            self._report(self._if.STATUS_DIVERGED, f"the run diverged at t = {cd.t:.6g} s (internal time)")
             return False
         n = self._substeps(omega, h)
         dt = h / n
@@ -403,8 +431,7 @@ class RotorCasingContact(Fmi2Slave):
         if done < n:
             self._report(self._if.STATUS_DIVERGED, f"the run diverged at t = {cd.t:.6g} s (internal time): a blade "
                          f"penetrated the casing deeper than max_penetration = {cd.max_penetration * 1e3:g} mm (or "
-                         "the state stopped being finite); the outputs are those of that state; roll back with "
-                         "fmi2SetFMUstate or reset")
+                         "the state stopped being finite); the outputs are those of that state")
             return False
         iv[self._i_status] = self._if.STATUS_OK
         return True
@@ -425,6 +452,12 @@ class RotorCasingContact(Fmi2Slave):
         self._rv[self._i_dt] = 0.0
         self._iv[self._i_nsub] = 0
         self._write_outputs(st.q, omega, phi, max_real=max_real)
+        # the physical scale of a transient applies here too (as in the native FMU)
+        gmin, max_pen = float(self._rv[self._i_gmin]), sim["config"]["max_penetration"]
+        if gmin < -max_pen:
+            return False, (f"the balanced solution at Omega = {omega:g} rad/s, imbalance = {me:g} kg.m, g0 = "
+                           f"{sim['g0'] * 1e3:g} mm penetrates the casing by {-gmin * 1e3:.4g} mm, deeper than "
+                           f"max_penetration = {max_pen * 1e3:g} mm: a divergence (the outputs are that solution's)")
         self._iv[self._i_status] = self._if.STATUS_UNSTABLE if max_real > RE_TOL else self._if.STATUS_OK
         return True, ""
 
@@ -457,6 +490,7 @@ class RotorCasingContact(Fmi2Slave):
             "version": STATE_VERSION, "guid": str(self.guid),
             "rv": self._rv.copy(), "iv": self._iv.copy(), "sv": list(self._sv),
             "phase": self._phase, "t": self._t, "fatal": self._fatal_msg, "sim": None,
+            "stopped": None if self._stopped is None else list(self._stopped),
         }
         if sim is not None:
             s = {"config": dict(sim["config"]), "g0": sim["g0"], "phi": sim["phi"],
@@ -515,6 +549,7 @@ class RotorCasingContact(Fmi2Slave):
         self._sv[:] = list(state["sv"])
         self._phase, self._t, self._fatal_msg = state["phase"], float(state["t"]), state["fatal"]
         self._pending, self._stale = None, False
+        self._stopped = None if state.get("stopped") is None else (float(state["stopped"][0]), str(state["stopped"][1]))
         s = state["sim"]
         if s is None:
             self._sim = None
