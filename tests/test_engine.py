@@ -1,7 +1,9 @@
-"""Engine coupling: the LP spool FMU, the SSP of the coupled system, the fmpy co-simulation master.
+"""Engine coupling: the LP spool FMU (native C and pythonfmu), the SSP of the coupled system, the masters.
 
-Both FMUs are built once from the current sources into a temporary folder (the
-contact FMU with fmu_src/build/pythonfmu_fmu.py, the spool FMU with fmu_src.engine.coupling.build_spool_fmu).
+The engine system is the native spool with the native contact FMU (no Python anywhere); the pythonfmu
+spool, the example of a slave in Python, is run with the pythonfmu contact FMU. Both pairs are built once
+from the current sources (conftest's contact FMUs, fmu_src.engine.spool's spool builds) and every physics
+test runs on both.
 The coupled scenario (fmu_src.engine.coupling.scenario_settings(quick=True)): the spool runs up
 from 2.8 to 4.2 x omega_ref (half-cosine, 0.5 s -> 4.5 s) through the first critical
 speed (3.49 x omega_ref) with the reference imbalance 22 kg mm, 3D contact, h = 1 ms,
@@ -36,10 +38,12 @@ from fmu_src.engine.coupling import (  # noqa: E402
     validate_ssp,
     write_ssp,
 )
+from fmu_src.engine.spool import build_native_spool_fmu  # noqa: E402
+from fmu_src.harness.fmi_run import FMUError  # noqa: E402
 
 CFG = scenario_settings(quick=True)
 SP = CFG["spool_params"]
-J_REF, CW_REF = 55.5, 0.05  # the spool FMU's defaults (fmu_src/pythonfmu/spool_slave.py)
+J_REF, CW_REF = 55.5, 0.05  # the spool FMU's defaults (fmu_src/engine/spool_interface.py)
 
 
 def schedule(t, w0=SP["Omega0"], w1=SP["Omega1"], t1=SP["t_ramp_start"], T=SP["t_ramp"]):
@@ -74,9 +78,16 @@ def integrate_spool(t_eval, tau_ext, J=J_REF, cw=CW_REF):
 
 
 @pytest.fixture(scope="module")
-def fmus(tmp_path_factory, contact_fmu):
+def spools(tmp_path_factory):
     d = tmp_path_factory.mktemp("engine_fmus")
-    return {"contact": Path(contact_fmu), "spool": build_spool_fmu(d), "dir": d}
+    return {"native": build_native_spool_fmu(d / "native", platforms=("linux64",)), "pythonfmu": build_spool_fmu(d)}
+
+
+@pytest.fixture(scope="module", params=["native", "pythonfmu"])
+def fmus(request, spools):
+    """A spool flavour with the contact FMU of the same flavour."""
+    contact = request.getfixturevalue("native_fmu" if request.param == "native" else "contact_fmu")
+    return {"contact": Path(contact), "spool": spools[request.param], "flavour": request.param}
 
 
 @pytest.fixture(scope="module")
@@ -97,8 +108,65 @@ def test_both_fmus_pass_fmpy_validation(fmus):
         names = z.namelist()
     assert "<InitialUnknowns>" in md and "<UnitDefinitions>" in md
     assert 'canGetAndSetFMUstate="true"' in md and 'canSerializeFMUstate="true"' in md
-    # the script travels under a hashed module name (pythonfmu FMUs share sys.modules)
-    assert any(n.startswith("resources/lpspool_") and n.endswith(".py") for n in names)
+    if fmus["flavour"] == "pythonfmu":  # the script travels under a hashed module name (one sys.modules)
+        assert any(n.startswith("resources/lpspool_") and n.endswith(".py") for n in names)
+    else:  # C, with its sources, no Python
+        assert "binaries/linux64/LPSpool.so" in names and "sources/spool_model.c" in names
+
+
+def test_both_spool_flavours_have_one_interface_and_the_same_numbers(spools):
+    """Same variables, value references, units, ranges and start values; under a braking torque the same
+    speeds to round-off (the schedule's cosine is rr_math.h's in C, Python's in the slave)."""
+    from fmpy import read_model_description
+
+    mds = {f: read_model_description(str(p)) for f, p in spools.items()}
+    rows = {f: [(v.name, v.valueReference, v.causality, v.unit, v.min, v.max, v.start) for v in md.modelVariables]
+            for f, md in mds.items()}
+    assert rows["native"] == rows["pythonfmu"]
+    w = {}
+    for f, path in spools.items():
+        s = FmuInstance(path, f"same_{f}")
+        try:
+            s.initialize(0.0, 5.0, **SP)
+            out = []
+            for k in range(5000):
+                s.set(friction_torque=-400.0 if 1.0 <= k * 1e-3 < 3.0 else 0.0)
+                s.fmu.doStep(k * 1e-3, 1e-3)
+                out.append([s.get(n) for n in ("Omega", "Omega_schedule", "drive_torque", "windage_torque")])
+            w[f] = np.array(out)
+        finally:
+            s.close()
+    assert w["native"][-1, 0] < w["native"][-1, 1] - 1.0  # the torque did act
+    np.testing.assert_allclose(w["native"], w["pythonfmu"], rtol=1e-12, atol=1e-12)
+
+
+def test_a_stopping_spool_ends_the_run_and_a_rollback_goes_on(fmus):
+    """A braking torque that would stop the spool: that step is refused (fmi2Discard, status 1) with the reason,
+    the FMU asks to end the run (fmi2Terminated) and refuses another step; a rollback to a state saved before
+    lets the run go on with a smaller torque."""
+    from fmpy.fmi2 import fmi2Terminated
+
+    s = FmuInstance(fmus["spool"], "stops")
+    try:
+        s.initialize(0.0, 1.0, **{**SP, "Omega0": 5.0, "Omega1": 5.0})
+        state = s.fmu.getFMUstate()
+        s.set(friction_torque=-2000.0)  # 36 rad/s^2 down from 5 rad/s: stopped before 0.14 s
+        with pytest.raises(FMICallException, match="discard"):
+            for k in range(1000):
+                s.fmu.doStep(k * 1e-3, 1e-3)
+        assert 0.1 < k * 1e-3 < 0.2 and s.get("status") == 1 and "would stop" in s.get("message")
+        assert s.fmu.getBooleanStatus(fmi2Terminated)
+        with pytest.raises(FMICallException):
+            s.fmu.doStep(k * 1e-3, 1e-3)
+        assert "ended this simulation" in s.get("message")
+        s.fmu.setFMUstate(state)
+        s.set(friction_torque=-10.0)
+        for k in range(200):
+            s.fmu.doStep(k * 1e-3, 1e-3)
+        assert s.get("status") == 0 and 0.0 < s.get("Omega") < 5.0
+        s.fmu.freeFMUstate(state)
+    finally:
+        s.close()
 
 
 # ------------------------------------------------------------------------------------------ (b) no rub
@@ -253,31 +321,26 @@ def test_spool_rollback_reproduces_a_run_exactly(fmus):
 
 # ------------------------------------------------------------------------------------------ (f) bad input
 def test_bad_input_is_reported_through_fmpy_and_a_new_instance_works(fmus):
-    # a bad parameter: refused at initialization with a message naming it
-    with pytest.raises(EngineError, match=r"J: -1\.0 kg\.m2 out of range"):
+    """A parameter or an input outside its declared range: the native spool refuses it at the fmi2SetReal
+    (fmi2Error, the message names it and the range); the pythonfmu one logs it there and refuses the next
+    step (its documented limit). The state is kept and the instance, or a new one, goes on."""
+    native = fmus["flavour"] == "native"
+    refused = r"J = -1(\.0)? .*out of range; accepted range \[0\.001, (1e\+05|100000\.0)\]"
+    with pytest.raises(EngineError, match=refused):
         run_coupled(fmus["contact"], fmus["spool"], t_end=0.01, spool_params={"J": -1.0})
-    s = FmuInstance(fmus["spool"], "bad_J")
-    try:
-        s.fmu.setupExperiment(startTime=0.0)
-        s.fmu.enterInitializationMode()
-        s.set(J=0.0)
-        s.fmu.exitInitializationMode()
-        with pytest.raises(FMICallException, match="discard"):
-            s.fmu.doStep(0.0, 1e-3)
-        assert any(m.startswith("LPSpool: J: 0.0 kg.m2 out of range") for m in s.log.problems())
-        assert s.get("status") == 2
-    finally:
-        s.close()
-    # a NaN input: that step is refused, the state is kept, the instance goes on
     s = FmuInstance(fmus["spool"], "nan_torque")
     try:
         s.initialize(0.0, 1.0)
         s.fmu.doStep(0.0, 1e-3)
         w = s.get("Omega")
-        s.set(friction_torque=float("nan"))
-        with pytest.raises(FMICallException):
-            s.fmu.doStep(1e-3, 1e-3)
-        assert any("friction_torque: nan N.m is not finite" in m for m in s.log.problems())
+        if native:
+            with pytest.raises(FMUError, match="friction_torque = nan is not finite"):
+                s.set(friction_torque=float("nan"))
+        else:
+            s.set(friction_torque=float("nan"))
+            with pytest.raises(FMICallException, match="discard"):
+                s.fmu.doStep(1e-3, 1e-3)
+        assert any("friction_torque = nan" in m and "accepted range" in m for m in s.log.problems())
         assert s.get("Omega") == w and s.get("status") == 2
         s.set(friction_torque=0.0)
         s.fmu.doStep(1e-3, 1e-3)
@@ -289,24 +352,66 @@ def test_bad_input_is_reported_through_fmpy_and_a_new_instance_works(fmus):
     assert r.meta["steps_done"] == 50 and np.array_equal(r.omega, schedule(r.t)[0])
 
 
-@pytest.mark.parametrize("flavour", ["pythonfmu", "native"])
-def test_ssp_runs_in_libcosim_and_gives_the_fmpy_master_loops_spool_speed(flavour, fmus, tmp_path, request):
-    """The package as written, loaded by a second co-simulation engine (OSP libcosim, from_ssp_file), with
-    either contact FMU: with rub, its spool speed and friction torque are the fmpy loop's (both masters
-    exchange at the communication points and hold the inputs over the step)."""
+def _rub_ssp(fmus, tmp_path, t_end):
+    sp = {**SP, "Omega0": 183.0, "Omega1": 190.0, "t_ramp_start": 0.1, "t_ramp": 1.0}  # at the critical: rub
+    ssp = write_ssp(tmp_path / "engine.ssp", fmus["contact"], fmus["spool"], g0=CFG["g0_rub"],
+                    imbalance=CFG["imbalance"], spool_params=sp, t_end=t_end, h=CFG["h"])
+    assert validate_ssp(ssp) == []
+    ref = run_coupled(fmus["contact"], fmus["spool"], t_end=t_end, h=CFG["h"], g0=CFG["g0_rub"],
+                      imbalance=CFG["imbalance"], spool_params=sp)
+    assert ref.friction_torque.min() < -1.0, "the scenario must rub for the comparison to say something"
+    return ssp, ref
+
+
+def test_ssp_runs_in_libcosim_and_gives_the_fmpy_master_loops_spool_speed(fmus, tmp_path):
+    """The package as written, loaded by a second co-simulation engine (OSP libcosim, from_ssp_file): with rub,
+    its spool speed and friction torque are the fmpy loop's (both masters exchange at the communication points
+    and hold the inputs over the step)."""
     pytest.importorskip("libcosimpy", reason="libcosimpy: Linux x86_64, Python >= 3.11")
     from fmu_src.engine.ssp import run_ssp_libcosim
 
-    contact = Path(request.getfixturevalue("contact_fmu" if flavour == "pythonfmu" else "native_fmu"))
-    t_end = 1.2
-    sp = {**SP, "Omega0": 183.0, "Omega1": 190.0, "t_ramp_start": 0.1, "t_ramp": 1.0}  # at the critical: rub
-    ssp = write_ssp(tmp_path / "engine.ssp", contact, fmus["spool"], g0=CFG["g0_rub"], imbalance=CFG["imbalance"],
-                    spool_params=sp, t_end=t_end, h=CFG["h"])
-    assert validate_ssp(ssp) == []
-    lc = run_ssp_libcosim(ssp, t_end, CFG["h"])
-    ref = run_coupled(contact, fmus["spool"], t_end=t_end, h=CFG["h"], g0=CFG["g0_rub"], imbalance=CFG["imbalance"],
-                      spool_params=sp)
-    assert ref.friction_torque.min() < -1.0, "the scenario must rub for the comparison to say something"
+    ssp, ref = _rub_ssp(fmus, tmp_path, 1.2)
+    lc = run_ssp_libcosim(ssp, 1.2, CFG["h"])
     np.testing.assert_allclose(lc["spool.Omega"], ref.omega[1:], rtol=1e-9)
     np.testing.assert_allclose(lc["contact.friction_torque"], ref.friction_torque[1:], rtol=1e-9,
                                atol=1e-9 * np.abs(ref.friction_torque).max())
+
+
+def test_ssp_runs_in_a_process_with_no_python(fmus, tmp_path):
+    """The package as written, run by a C master (fmu_src/native_host/engine_host.c) in an environment without
+    Python: the native pair gives the fmpy loop's spool speed and friction torque bit for bit (same exchange,
+    same FMUs). The pythonfmu pair cannot even load there: its binaries need libpython, which is the point."""
+    import sys
+
+    if sys.platform != "linux":
+        pytest.skip("the C master is run here on Linux")
+    from fmu_src.engine.ssp import run_ssp_native
+
+    ssp, ref = _rub_ssp(fmus, tmp_path, 1.2)
+    if fmus["flavour"] == "pythonfmu":
+        with pytest.raises(EngineError, match="undefined symbol"):
+            run_ssp_native(ssp, 1.2)
+        return
+    nat = run_ssp_native(ssp, 1.2)
+    assert np.array_equal(nat["t"], ref.t[1:])
+    assert np.array_equal(nat["spool.Omega"], ref.omega[1:])
+    assert np.array_equal(nat["contact.friction_torque"], ref.friction_torque[1:])
+
+
+def test_ssd_carries_omsimulators_system_annotation_and_a_proper_name(fmus, tmp_path):
+    """OMSimulator 3.0 aborts on an SSD whose system lacks its org.openmodelica annotation (the master: a
+    fixed-step co-simulation); the system is named for what it is (it was named after a loop variable)."""
+    from xml.etree import ElementTree as ET
+
+    from fmu_src.engine.ssp import NS, OMS_NS
+
+    ssp = write_ssp(tmp_path / "engine.ssp", fmus["contact"], fmus["spool"], h=2e-3)
+    assert validate_ssp(ssp) == []
+    with zipfile.ZipFile(ssp) as z:
+        root = ET.fromstring(z.read("SystemStructure.ssd"))
+    system = root.find("ssd:System", NS)
+    assert root.get("name") == system.get("name") == "RotorRubEngine"
+    ann = system.find("ssd:Annotations/ssc:Annotation", NS)
+    assert ann.get("type") == "org.openmodelica"
+    master = ann.find(f"{{{OMS_NS}}}Annotations/{{{OMS_NS}}}SimulationInformation/{{{OMS_NS}}}FixedStepMaster")
+    assert master is not None and master.get("description") == "oms-ma" and float(master.get("stepSize")) == 2e-3

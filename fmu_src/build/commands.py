@@ -41,8 +41,8 @@ def _run_build(ns: argparse.Namespace) -> dict:
     from rotorub_model.errors import ParameterError
     from rotorub_model.kernel.compiler import CompilerError
 
-    from .pythonfmu_fmu import BuildError
     from .native_fmu import NativeBuildError
+    from .pythonfmu_fmu import BuildError
 
     default = Path("fmus") / ("native" if ns.native else "")
     dest = default if ns.out == "out/build-fmu" else Path(ns.out)

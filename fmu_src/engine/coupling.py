@@ -5,12 +5,11 @@
 This module is the master loop and the scenario; the spool FMU is fmu_src/engine/spool.py's, the SSP
 package fmu_src/engine/ssp.py's, what they share fmu_src/engine/system.py's. Pieces:
 
-* :func:`build_spool_fmu` builds ``LPSpool.fmu`` from fmu_src/pythonfmu/spool_slave.py with
-  pythonfmu (same recipe as fmu_src/build/pythonfmu_fmu.py: the script is staged under a hashed
-  module name, ``lpspool_<hash>``, because every pythonfmu FMU in a process shares
-  one ``sys.modules``). The spool: J dOmega/dt = tau_drive(t) - c_w Omega^2 +
-  friction_torque, with a drive torque schedule that makes the rub-free spool follow
-  a half-cosine run-up Omega0 -> Omega1 exactly (see the slave's docstring).
+* :func:`build_native_spool_fmu` builds ``LPSpool.fmu`` in C (the engine system's spool, no Python on
+  the host); :func:`build_spool_fmu` the same FMU with pythonfmu (the example of a slave in Python).
+  The spool: J dOmega/dt = tau_drive(t) - c_w Omega^2 + friction_torque, with a drive torque schedule
+  that makes the rub-free spool follow a half-cosine run-up Omega0 -> Omega1 exactly
+  (fmu_src/engine/spool_interface.py).
 * :func:`write_ssp` writes an SSP 1.0 package (a zip): ``SystemStructure.ssd`` naming
   the two FMUs (``resources/RotorCasingContact.fmu`` as component ``contact``,
   ``resources/LPSpool.fmu`` as ``spool``), their connections (spool.Omega ->
@@ -58,7 +57,12 @@ import numpy as np
 from rotorub_model.results import pyplot, save_figure, write_json
 
 from ..harness.fmi_run import FMUError, Slave
-from .spool import build_contact_fmu, build_spool_fmu, spool_defaults  # noqa: F401 - the engine system's API
+from .spool import (  # noqa: F401 - the engine system's API
+    build_contact_fmu,
+    build_native_spool_fmu,
+    build_spool_fmu,
+    spool_defaults,
+)
 from .ssp import ssp_contents, validate_ssp, write_ssp  # noqa: F401
 from .system import (  # noqa: F401
     CONNECTIONS,
@@ -298,11 +302,14 @@ def run_coupled(contact_fmu: str | Path, spool_fmu: str | Path, t_end: float, h:
     contact = None
     try:
         contact = FmuInstance(contact_fmu, "contact")
-        spool.initialize(t_start, t_end, **(spool_params or {}))
-        omega0 = spool.get("Omega")
-        cstart = {"formulation": formulation, "mode": "transient", "g0": g0, "imbalance": imbalance,
-                  "Omega": omega0, **(contact_params or {})}
-        contact.initialize(t_start, t_end, **cstart)
+        try:
+            spool.initialize(t_start, t_end, **(spool_params or {}))
+            omega0 = spool.get("Omega")
+            cstart = {"formulation": formulation, "mode": "transient", "g0": g0, "imbalance": imbalance,
+                      "Omega": omega0, **(contact_params or {})}
+            contact.initialize(t_start, t_end, **cstart)
+        except FMUError as exc:  # a value refused at its set (the native FMUs): the same error as a refused step
+            raise EngineError(f"run_coupled: initialisation refused ({exc})", exc.messages) from None
         J = spool.get("J")
         nb = sum(1 for name in contact.variables if name.startswith("blade[") and name.endswith("].F_N"))
 
@@ -412,15 +419,19 @@ def scenario_settings(quick: bool = True) -> dict:
 def run_coupled_scenario(out_dir: str | Path, quick: bool = True, contact_fmu: str | Path | None = None,
                          spool_fmu: str | Path | None = None, progress: bool = False,
                          fmu_dir: str | Path | None = None) -> dict:
-    """Build the FMUs (unless given), write and validate the SSP, run the rub-free and the rub cases,
-    and save ``no_rub.npz``, ``rub.npz``, ``coupled_runup.png``, ``summary.json`` in ``out_dir``."""
+    """Build the FMUs (unless given: the native contact and spool FMUs, no Python on a host), write and
+    validate the SSP, run the rub-free and the rub cases in the fmpy master loop, the rub case's SSP in libcosim
+    and in the C master (no Python in the process), and save ``no_rub.npz``, ``rub.npz``, ``coupled_runup.png``,
+    ``summary.json`` in ``out_dir``."""
+    from ..build.native_fmu import build_native_fmu
+
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     cfg = scenario_settings(quick)
     t0 = time.perf_counter()
     fmu_dir = Path(fmu_dir) if fmu_dir else out / "fmus"
-    contact_fmu = Path(contact_fmu) if contact_fmu else build_contact_fmu(fmu_dir)
-    spool_fmu = Path(spool_fmu) if spool_fmu else build_spool_fmu(fmu_dir)
+    contact_fmu = Path(contact_fmu) if contact_fmu else Path(build_native_fmu(fmu_dir / "native")["fmu"])
+    spool_fmu = Path(spool_fmu) if spool_fmu else build_native_spool_fmu(fmu_dir / "native")
     build_s = time.perf_counter() - t0
     ssp = write_ssp(out / "RotorRubEngine.ssp", contact_fmu, spool_fmu, g0=cfg["g0_rub"], imbalance=cfg["imbalance"],
                     formulation=cfg["formulation"], spool_params=cfg["spool_params"], t_end=cfg["t_end"], h=cfg["h"])
@@ -450,6 +461,15 @@ def run_coupled_scenario(out_dir: str | Path, quick: bool = True, contact_fmu: s
     except EngineError as exc:
         summary["libcosim_ssp_spool_speed_max_rel_diff"] = None
         summary["libcosim_note"] = str(exc)
+    try:  # and in a native process: the C master, no Python anywhere (needs the native FMUs and a C compiler)
+        from .ssp import run_ssp_native
+
+        nat = run_ssp_native(ssp, cfg["t_end"], cfg["h"])
+        summary["native_host_ssp_spool_speed_max_rel_diff"] = float(np.abs(nat["spool.Omega"] - rub.omega[1:]).max()
+                                                                    / float(np.abs(rub.omega).max()))
+    except (EngineError, RuntimeError, OSError) as exc:
+        summary["native_host_ssp_spool_speed_max_rel_diff"] = None
+        summary["native_host_note"] = str(exc)
     write_json(out / "summary.json", summary)
     summary["figures"] = [("Coupled run-up: spool speed with and without rub, friction torque, contact forces",
                            "coupled_runup.png")]

@@ -1,9 +1,13 @@
-"""The LP spool FMU (fmu_src/pythonfmu/spool_slave.py, built with pythonfmu) and the contact FMU for the engine system.
+"""The LP spool FMU in both flavours and the contact FMU for the engine system.
 
-The spool: J dOmega/dt = tau_drive(t) - c_w Omega^2 + friction_torque, with a drive torque
-schedule that makes the rub-free spool follow a half-cosine run-up Omega0 -> Omega1 exactly
-(see the slave's docstring). The script is staged under a hashed module name, ``lpspool_<hash>``,
-because every pythonfmu FMU in a process shares one ``sys.modules``.
+* :func:`build_native_spool_fmu`: ``LPSpool.fmu`` in C (fmu_src/native/spool_model.c behind the same FMI
+  wrapper and build route as the native contact FMU): no Python on the host; the engine system's spool.
+* :func:`build_spool_fmu`: the same FMU written in Python with pythonfmu (fmu_src/pythonfmu/spool_slave.py),
+  the example of a slave in Python. The script is staged under a hashed module name, ``lpspool_<hash>``,
+  because every pythonfmu FMU in a process shares one ``sys.modules``, with the interface next to it.
+
+Both have fmu_src/engine/spool_interface.py's variables, value references, ranges and start values, and
+the same numbers to round-off (the native schedule's cosine is rr_math.h's, the slave's Python's).
 """
 
 from __future__ import annotations
@@ -15,39 +19,100 @@ import sys
 import tempfile
 from pathlib import Path
 
+from . import spool_interface as si
 from .system import SPOOL_ID, EngineError
 
 HERE = Path(__file__).resolve().parent.parent  # fmu_src/
 SPOOL_SCRIPT = HERE / "pythonfmu" / "spool_slave.py"
+INTERFACE = Path(si.__file__)
+NATIVE_SOURCES = ("fmi2_cs.c", "spool_model.c", "model_data.c")
+# the value references spool_model.c reads (its enum), checked against the interface at build
+C_ORDER = ("friction_torque", "J", "c_w", "Omega0", "Omega1", "t_ramp_start", "t_ramp", "dt_max", "Omega",
+           "Omega_schedule", "drive_torque", "windage_torque")
 
 
 def spool_defaults() -> dict:
-    """The spool FMU's default parameter values (module defaults of fmu_src/pythonfmu/spool_slave.py)."""
-    from ..pythonfmu import spool_slave
+    """The spool FMU's default parameter values (spool_interface.DEFAULTS)."""
+    return dict(si.DEFAULTS)
 
-    return dict(spool_slave.DEFAULTS)
+
+def _values(defaults: dict) -> dict:
+    values = spool_defaults()
+    unknown = sorted(set(defaults) - set(values))
+    if unknown:
+        raise EngineError(f"spool FMU: unknown parameter(s) {', '.join(unknown)}; known: {', '.join(values)}")
+    for k, v in defaults.items():
+        v = float(v)
+        lo, hi = next(s[5] for s in si.SPECS if s[0] == k)
+        if not (math.isfinite(v) and lo <= v <= hi):
+            raise EngineError(f"spool FMU: {k} = {v!r} out of range; accepted range [{lo!r}, {hi!r}]")
+        values[k] = v
+    return values
+
+
+def spool_variables(values: dict | None = None):
+    """spool_interface.SPECS as interface.Var (what the native build writes; value reference = position)."""
+    from ..interface import Var
+
+    values = values or spool_defaults()
+    out = []
+    for k, (name, typ, causality, variability, unit, rng, desc) in enumerate(si.SPECS):
+        start = values.get(name, 0.0) if causality != "output" else None
+        nominal = (abs(start) or 1.0) if typ == "Real" and causality != "output" else None
+        out.append(Var(name, typ, causality, variability, desc, unit=unit, start=start,
+                       min=None if rng is None else rng[0], max=None if rng is None else rng[1], nominal=nominal,
+                       vr=k))
+    return out
+
+
+def build_native_spool_fmu(dest: str | Path = "fmus/native", platforms: tuple[str, ...] | None = None,
+                           **defaults) -> Path:
+    """Build ``dest/LPSpool.fmu`` in C; keyword arguments override the parameters' start values."""
+    from rotorub_model import __version__ as lib_version
+
+    from .. import interface
+    from ..build.native_fmu import NATIVE, WRAPPER, documentation_html, package_native_fmu, variable_table
+
+    values = _values(defaults)
+    variables = spool_variables(values)
+    if tuple(v.name for v in variables[:len(C_ORDER)]) != C_ORDER:
+        raise EngineError(f"spool interface order changed: spool_model.c expects {C_ORDER}")
+    sources = [NATIVE / "spool_model.c", *(NATIVE / n for n in WRAPPER)]
+    guid = interface.guid_of(json.dumps([v.__dict__ for v in variables], sort_keys=True, default=str),
+                             *(p.read_bytes() for p in sources))
+    md = interface.model_description(
+        variables, guid=guid, generation_tool=f"rotorub {lib_version} (native C)", version=lib_version,
+        needs_execution_tool=False, feedthrough=False, source_files=list(NATIVE_SOURCES), model_name=SPOOL_ID,
+        model_identifier=SPOOL_ID, description=si.DESCRIPTION, units={k: (v, {}) for k, v in si.UNITS.items()},
+        enumerations={}, default_experiment=si.DEFAULT_EXPERIMENT)
+    out = Path(dest) / f"{SPOOL_ID}.fmu"
+    data = ("/* model_data.c: generated by fmu_src/engine/spool.py from spool_interface.py; do not edit. */\n"
+            "#include \"fmu_model.h\"\n\n" + variable_table(variables, guid, SPOOL_ID, feedthrough=False))
+    facts = ("J dOmega/dt = tau_drive(t) - c_w Omega<sup>2</sup> + friction_torque, RK4 in ceil(h/dt_max) substeps "
+             "with the input held; the drive schedule makes the rub-free spool follow the half-cosine run-up "
+             "Omega0 &rarr; Omega1 exactly. A step at whose end the spool would stop is refused (fmi2Discard, "
+             "status 1) and ends the run (fmi2Terminated).")
+    package_native_fmu(out, identifier=SPOOL_ID, variables=variables, guid=guid,
+                       model_sources={"spool_model.c": NATIVE / "spool_model.c", "model_data.c": data},
+                       c_files=NATIVE_SOURCES, description_xml=interface.xml_bytes(md), platforms=platforms,
+                       documentation={"index.html": documentation_html(SPOOL_ID, si.DESCRIPTION, variables, facts)})
+    return out
 
 
 def build_spool_fmu(dest: str | Path = "fmus", **defaults) -> Path:
-    """Build ``dest/LPSpool.fmu``; keyword arguments override the parameters' start values
+    """Build ``dest/LPSpool.fmu`` with pythonfmu; keyword arguments override the parameters' start values
     (J, c_w, Omega0, Omega1, t_ramp_start, t_ramp, dt_max). Needs pythonfmu."""
     try:
         from pythonfmu import FmuBuilder
         from pythonfmu import __version__ as pythonfmu_version
     except ImportError:
         raise EngineError("pythonfmu is not installed: pip install 'rotorub[fmu]'") from None
-    values = spool_defaults()
-    unknown = sorted(set(defaults) - set(values))
-    if unknown:
-        raise EngineError(f"build_spool_fmu: unknown parameter(s) {', '.join(unknown)}; known: {', '.join(values)}")
-    for k, v in defaults.items():
-        v = float(v)
-        if not math.isfinite(v):
-            raise EngineError(f"build_spool_fmu: {k} = {v!r} is not finite")
-        values[k] = v
-    script_bytes = SPOOL_SCRIPT.read_bytes()
-    tag = hashlib.sha256(script_bytes + pythonfmu_version.encode()).hexdigest()[:10]
-    module_name = f"lpspool_{tag}"
+    from ..interface import guid_of
+
+    values = _values(defaults)
+    script_bytes, interface_bytes = SPOOL_SCRIPT.read_bytes(), INTERFACE.read_bytes()
+    tag = hashlib.sha256(script_bytes + interface_bytes + pythonfmu_version.encode()).hexdigest()[:10]
+    module_name, interface_name = f"lpspool_{tag}", f"lpspool_interface_{tag}"
     dest = Path(dest)
     dest.mkdir(parents=True, exist_ok=True)
     out_file = dest / f"{SPOOL_ID}.fmu"
@@ -58,28 +123,27 @@ def build_spool_fmu(dest: str | Path = "fmus", **defaults) -> Path:
         stage.mkdir()
         script = stage / f"{module_name}.py"
         script.write_bytes(script_bytes)
-        defaults_file = stage / "lpspool_defaults.json"
-        defaults_file.write_text(json.dumps(values, indent=1))
+        (stage / f"{interface_name}.py").write_bytes(interface_bytes)
+        manifest = stage / "lpspool_defaults.json"
+        manifest.write_text(json.dumps({"interface": interface_name, "defaults": values,
+                                        "guid": guid_of("pythonfmu", tag, json.dumps(values, sort_keys=True))},
+                                       indent=1))
         doc = Path(tmp) / "documentation"
         doc.mkdir()
         rows = "\n".join(f"<tr><td><code>{k}</code></td><td>{v!r}</td></tr>" for k, v in values.items())
         (doc / "index.html").write_text(
             "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>LPSpool</title></head><body>\n"
             "<h1>LPSpool &mdash; low-pressure spool speed (FMI 2.0 co-simulation, pythonfmu)</h1>\n"
-            "<p>J dOmega/dt = tau_drive(t) - c_w Omega<sup>2</sup> + friction_torque. The drive torque schedule "
-            "tau_drive = J dOmega_s/dt + c_w Omega_s<sup>2</sup> makes the spool follow the half-cosine speed "
-            "schedule Omega_s(t) (Omega0 until t_ramp_start, Omega1 after t_ramp_start + t_ramp) exactly when no "
-            "external torque acts. Integration: RK4 on e = Omega - Omega_s with ceil(h/dt_max) substeps per "
-            "communication step, friction_torque held (zero-order hold). Rollback: fmi2Get/SetFMUstate and "
-            "serialization. Bad parameters or inputs: fmi2DoStep returns fmi2Discard after a log message naming "
-            "the variable (log with loggingOn = true).</p>\n<p>Needs a CPython 3.10+ host (pythonfmu); no other "
-            f"package.</p>\n<h2>Parameter start values</h2><table border=\"1\">\n{rows}\n</table></body></html>\n")
+            f"<p>{si.DESCRIPTION}</p>\n<p>The same model as the native LPSpool.fmu (which the engine system "
+            "uses); this one is the example of a slave written in Python. Needs a CPython 3.10+ host "
+            f"(pythonfmu); no other package.</p>\n<h2>Parameter start values</h2><table border=\"1\">\n{rows}\n"
+            "</table></body></html>\n")
         try:
-            FmuBuilder.build_FMU(script, dest=out_file, project_files=[defaults_file], documentation_folder=doc,
-                                 canGetAndSetFMUstate=True, canSerializeFMUstate=True)
+            FmuBuilder.build_FMU(script, dest=out_file, project_files=[manifest, stage / f"{interface_name}.py"],
+                                 documentation_folder=doc, canGetAndSetFMUstate=True, canSerializeFMUstate=True)
         finally:
             for m in set(sys.modules) - before:
-                if m.split(".")[0] == module_name:
+                if m.split(".")[0] in (module_name, interface_name):
                     sys.modules.pop(m, None)
             sys.path[:] = path_before
     return out_file
@@ -90,5 +154,3 @@ def build_contact_fmu(dest: str | Path = "fmus") -> Path:
     from ..build.pythonfmu_fmu import build_fmu
 
     return Path(build_fmu(dest)["fmu"])
-
-

@@ -10,10 +10,17 @@
   connector, connection and parameter exists in the FMUs.
 * :func:`run_ssp_libcosim` runs the package as written in libcosim
   (``CosimExecution.from_ssp_file``): a second, independent co-simulation engine.
+* :func:`run_ssp_native` runs it in a process with no Python: fmu_src/native_host/engine_host.c, a
+  fixed-step C master, given the package's components, parameter sets, connections and step.
+
+The system carries the annotation OpenModelica's OMSimulator reads to know how to run it (type
+``org.openmodelica``: a fixed-step co-simulation master, ``oms:FixedStepMaster``); without it OMSimulator
+3.0 aborts on load. libcosim ignores it; both read the standard parts.
 """
 
 from __future__ import annotations
 
+import io
 import zipfile
 from functools import cache
 from pathlib import Path
@@ -41,9 +48,11 @@ NS = {
     "ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
 }
 MASTER_NS = "urn:rotorub:ssp:master"  # our annotation (communication step and exchange order)
+OMS_NS = "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd"  # OMSimulator's
 for _p, _u in NS.items():
     ET.register_namespace(_p, _u)
 ET.register_namespace("rotorub", MASTER_NS)
+ET.register_namespace("oms", OMS_NS)
 
 
 def _q(prefix: str, tag: str) -> str:
@@ -131,11 +140,11 @@ def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, 
     # Enumeration parameters only when they differ from the FMU's defaults: libcosim's SSP parser (0.0.6)
     # stops at any Enumeration ("Don't know how to handle Enumeration type"), and the defaults need no value
     items = enumerations(croot)
-    for name, value in (("formulation", formulation), ("mode", mode)):
-        var = cvars[name]
+    for pname, value in (("formulation", formulation), ("mode", mode)):
+        var = cvars[pname]
         default = next((n for n, v in items.get(var.declared_type or "", []) if str(v) == var.start), var.start)
         if str(value) != default:
-            contact_values[name] = str(value)
+            contact_values[pname] = str(value)
     for k, v in (contact_params or {}).items():
         if k not in cvars or cvars[k].causality not in ("parameter", "input"):
             raise EngineError(f"write_ssp: contact parameter '{k}' is not a parameter or input of the contact FMU")
@@ -176,6 +185,11 @@ def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, 
     for se, sc, ee, ec in CONNECTIONS:
         ET.SubElement(connections, _q("ssd", "Connection"), startElement=se, startConnector=sc, endElement=ee,
                       endConnector=ec)
+    # OMSimulator: the system is a fixed-step co-simulation (its "oms-ma" master), with our step
+    oms = ET.SubElement(ET.SubElement(ET.SubElement(system, _q("ssd", "Annotations")), _q("ssc", "Annotation"),
+                                      type="org.openmodelica"), f"{{{OMS_NS}}}Annotations")
+    ET.SubElement(ET.SubElement(oms, f"{{{OMS_NS}}}SimulationInformation"), f"{{{OMS_NS}}}FixedStepMaster",
+                  description="oms-ma", stepSize=_fmt(h), absoluteTolerance="0.0001", relativeTolerance="0.0001")
     used = []
     for _c, _s, vars_, pvalues, conns in comps:
         for vname in [c for c, _k in conns] + list(pvalues):
@@ -373,3 +387,78 @@ def run_ssp_libcosim(ssp: str | Path, t_end: float, h: float = 1e-3,
             out[key][k] = observer.last_real_values(i, [ref])[0]
     del ex, observer
     return {"t": (np.arange(steps) + 1) * h, **out}
+
+
+def _ssp_model(z: zipfile.ZipFile, where: Path) -> dict:
+    """What a master needs from a package: components (name, unzipped FMU, model identifier, value references),
+    their parameter values (from the bound .ssv files), connections, the communication step."""
+    root = ET.fromstring(z.read("SystemStructure.ssd"))
+    comps = []
+    for comp in root.iter(_q("ssd", "Component")):
+        name, src = comp.get("name"), comp.get("source")
+        d = where / name
+        with zipfile.ZipFile(io.BytesIO(z.read(src))) as fz:
+            fz.extractall(d)
+        fvars, _, froot = read_description(d)
+        md_vr = {sv.get("name"): int(sv.get("valueReference")) for sv in froot.iter("ScalarVariable")}
+        items = enumerations(froot)
+        values = []
+        for b in comp.findall("ssd:ParameterBindings/ssd:ParameterBinding", NS):
+            sv = ET.fromstring(z.read(b.get("source")))
+            for par in sv.iter(_q("ssv", "Parameter")):
+                pname, val = par.get("name"), next(iter(par))
+                kind = val.tag.rpartition("}")[2]
+                if kind == "Real":
+                    values.append(("p", md_vr[pname], float(val.get("value"))))
+                elif kind == "Integer":
+                    values.append(("I", md_vr[pname], int(val.get("value"))))
+                elif kind == "Enumeration":
+                    values.append(("I", md_vr[pname], dict(items[fvars[pname].declared_type])[val.get("value")]))
+                else:
+                    raise EngineError(f"run_ssp_native: {name}.{pname}: {kind} parameters are not supported")
+        comps.append({"name": name, "dir": d, "model": froot.find("CoSimulation").get("modelIdentifier"),
+                      "vr": md_vr, "values": values})
+    conns = [(c.get("startElement"), c.get("startConnector"), c.get("endElement"), c.get("endConnector"))
+             for c in root.iter(_q("ssd", "Connection"))]
+    steps = [float(el.get("stepSize")) for ns in (OMS_NS, MASTER_NS) for el in root.iter(f"{{{ns}}}FixedStepMaster")]
+    return {"components": comps, "connections": conns, "step": steps[0] if steps else None}
+
+
+def run_ssp_native(ssp: str | Path, t_end: float, h: float | None = None,
+                   record: tuple[tuple[str, str], ...] = (("spool", "Omega"), ("contact", "friction_torque"))
+                   ) -> dict[str, np.ndarray]:
+    """Run an SSP package in fmu_src/native_host/engine_host.c: a C process with no Python in it (no libpython
+    loaded, an environment without Python's variables), as a native master would; the Python side only reads
+    the package into the host's command line. Jacobi exchange at a fixed step (the package's FixedStepMaster
+    step unless ``h`` is given). Returns the time points after each step and the recorded variables
+    ("component.variable")."""
+    import subprocess
+    import tempfile
+
+    from ..harness import native_host
+
+    host = native_host.cached_host("engine_host.c")
+    with tempfile.TemporaryDirectory(prefix="rotorub_ssp_") as tmp, zipfile.ZipFile(ssp) as z:
+        m = _ssp_model(z, Path(tmp))
+        h = h or m["step"]
+        if not h:
+            raise EngineError(f"run_ssp_native: {ssp} gives no communication step; pass h")
+        by = {c["name"]: c for c in m["components"]}
+        args = [str(host), "-q", "-n", str(int(round(t_end / h))), "-s", repr(h)]
+        for c in m["components"]:
+            args += ["-F", f"{c['name']}={c['dir']}:{c['model']}"]
+            args += [a for flag, vr, v in c["values"] for a in (f"-{flag}", f"{c['name']}:{vr}={v!r}")]
+        for se, sc, ee, ec in m["connections"]:
+            args += ["-c", f"{se}:{by[se]['vr'][sc]}={ee}:{by[ee]['vr'][ec]}"]
+        for comp, var in record:
+            if comp not in by or var not in by[comp]["vr"]:
+                raise EngineError(f"run_ssp_native: no variable {comp}.{var} in {ssp}")
+            args += ["-o", f"{comp}:{by[comp]['vr'][var]}"]
+        proc = subprocess.run(args, capture_output=True, text=True, timeout=1800, env={"PATH": "/usr/bin:/bin"})
+    if proc.returncode != 0:
+        raise EngineError(f"run_ssp_native: engine_host exit status {proc.returncode}", proc.stderr.splitlines()[-5:])
+    _, rows = native_host.read_csv(proc.stdout)
+    out = {"t": rows[1:, 0]}
+    for k, (comp, var) in enumerate(record):
+        out[f"{comp}.{var}"] = rows[1:, 1 + k]
+    return out

@@ -44,6 +44,22 @@ def compile_host(out: str | Path, platform: str | None = None, source: str = "fm
     return out
 
 
+def cached_host(source: str = "fmu_host.c") -> Path:
+    """This machine's build of a host, compiled once into the user cache (named by a hash of its sources)."""
+    import hashlib
+
+    from rotorub_model import kernel
+
+    h = hashlib.sha256()
+    for f in (HOST_DIR / source, HOST_DIR / "fmi2_host.h"):
+        h.update(f.read_bytes())
+    exe = kernel.cache_dir() / "hosts" / f"{Path(source).stem}-{h.hexdigest()[:16]}"
+    if not exe.exists():
+        tmp = compile_host(exe.with_name(exe.name + f".{os.getpid()}.tmp"), None, source)
+        os.replace(tmp, exe)
+    return exe
+
+
 def runner(platform: str) -> tuple[list[str] | None, str]:
     """(command prefix that runs a binary of ``platform`` here, or None; why not)."""
     import platform as _p

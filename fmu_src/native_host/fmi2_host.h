@@ -89,16 +89,16 @@ typedef struct {
 #define HOST_SUFFIX ".so"
 #endif
 
-static const char *status_name(fmi2Status s)
+static inline const char *status_name(fmi2Status s)
 {
     static const char *names[] = {"fmi2OK", "fmi2Warning", "fmi2Discard", "fmi2Error", "fmi2Fatal", "fmi2Pending"};
     return (s >= fmi2OK && s <= fmi2Pending) ? names[s] : "fmi2Status(?)";
 }
 
-static fmi2Status worst(fmi2Status a, fmi2Status b) { return a > b ? a : b; }
+static inline fmi2Status worst(fmi2Status a, fmi2Status b) { return a > b ? a : b; }
 
 /* ---------------------------------------------------------------- callbacks */
-static void host_logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2Status status, fmi2String category,
+static inline void host_logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2Status status, fmi2String category,
                         fmi2String message, ...)
 {
     va_list ap;
@@ -111,12 +111,12 @@ static void host_logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2S
     fflush(stderr);
 }
 
-static void *host_alloc(size_t n, size_t size) { return calloc(n, size); }
+static inline void *host_alloc(size_t n, size_t size) { return calloc(n, size); }
 
 static const fmi2CallbackFunctions host_callbacks = {host_logger, host_alloc, free, NULL, NULL};
 
 /* seconds on a monotonic clock */
-static double host_now(void)
+static inline double host_now(void)
 {
 #ifdef _WIN32
     LARGE_INTEGER f, c;
@@ -131,7 +131,7 @@ static double host_now(void)
 }
 
 /* ---------------------------------------------------------------- files */
-static char *read_file(const char *path)
+static inline char *read_file(const char *path)
 {
     FILE *f = fopen(path, "rb");
     long n;
@@ -151,7 +151,7 @@ static char *read_file(const char *path)
 }
 
 /* the guid="..." attribute of <fmiModelDescription> (first occurrence in the file) */
-static char *fmi2_read_guid(const char *dir)
+static inline char *fmi2_read_guid(const char *dir)
 {
     char path[4096], *xml, *p, *guid = NULL;
     snprintf(path, sizeof path, "%s/modelDescription.xml", dir);
@@ -175,7 +175,7 @@ static char *fmi2_read_guid(const char *dir)
 }
 
 /* the file:// URI of DIR/resources (only ' ' is escaped: what pythonfmu decodes) */
-static void fmi2_resource_uri(const char *dir, char *out, size_t len)
+static inline void fmi2_resource_uri(const char *dir, char *out, size_t len)
 {
     size_t k = (size_t)snprintf(out, len, "file://");
     const char *c;
@@ -184,7 +184,7 @@ static void fmi2_resource_uri(const char *dir, char *out, size_t len)
 }
 
 /* ---------------------------------------------------------------- loading */
-static void *sym(void *lib, const char *name)
+static inline void *sym(void *lib, const char *name)
 {
 #ifdef _WIN32
     return (void *)GetProcAddress((HMODULE)lib, name);
@@ -193,7 +193,7 @@ static void *sym(void *lib, const char *name)
 #endif
 }
 
-static const char *load_error(void)
+static inline const char *load_error(void)
 {
 #ifdef _WIN32
     static char buf[64];
@@ -206,7 +206,7 @@ static const char *load_error(void)
 
 /* Load DIR/binaries/PLATFORM/MODEL<suffix> (platform NULL: this host's) and resolve the functions; 0, or -1 with
  * the reason in err. */
-static int fmi2_load(fmi2_lib *f, const char *dir, const char *model, const char *platform, char *err, size_t len)
+static inline int fmi2_load(fmi2_lib *f, const char *dir, const char *model, const char *platform, char *err, size_t len)
 {
     memset(f, 0, sizeof *f);
     snprintf(f->path, sizeof f->path, "%s/binaries/%s/%s%s", dir, platform ? platform : HOST_PLATFORM, model,
@@ -254,7 +254,7 @@ static int fmi2_load(fmi2_lib *f, const char *dir, const char *model, const char
  * intermittently with this FMU (heap corruption, SIGSEGV after the results are written). Finalizing here, while
  * everything is intact, avoids it. Call it once, after the last fmi2FreeInstance of every pythonfmu FMU of the
  * process: the interpreter cannot be restarted (numpy cannot be imported twice). No-op for other FMUs. */
-static void fmi2_unload(fmi2_lib *f)
+static inline void fmi2_unload(fmi2_lib *f)
 {
     void (*finalize_python)(void);
     if (!f->lib) return;

@@ -1,9 +1,11 @@
-"""LPSpool: FMI 2.0 co-simulation slave for the speed of the low-pressure spool.
+"""LPSpool: FMI 2.0 co-simulation slave for the speed of the low-pressure spool, written with pythonfmu.
 
-This file is the pythonfmu script of ``LPSpool.fmu`` (built by
+This file is the pythonfmu script of the pythonfmu ``LPSpool.fmu`` (built by
 :func:`fmu_src.engine.spool.build_spool_fmu`, which stages it under a hashed module name,
-``lpspool_<hash>``: every pythonfmu FMU in a process shares one ``sys.modules``).
-It is self-contained: numpy is not even needed.
+``lpspool_<hash>``: every pythonfmu FMU in a process shares one ``sys.modules``). It is the example of
+a slave in Python; the engine system uses the native spool (fmu_src/native/spool_model.c), which has
+the same variables, value references, ranges and numbers to round-off. Both take their interface from
+fmu_src/engine/spool_interface.py (staged next to this script). numpy is not even needed.
 
 Model: one rigid spool of polar inertia J,
 
@@ -38,47 +40,32 @@ fmi2SetFMUstate or fmi2Reset).
 
 from __future__ import annotations
 
+import importlib
 import json
 import math
+import sys
 from pathlib import Path
 from xml.etree.ElementTree import Element, SubElement
 
-from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real
+from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real, String
 from pythonfmu.enums import Fmi2Status
 
-DEFAULTS_FILE = "lpspool_defaults.json"
+MANIFEST = "lpspool_defaults.json"  # parameter start values and the staged interface module's name
 STATUS_OK, STATUS_STOPPED, STATUS_ERROR = 0, 1, 2
-STATE_VERSION = 1
+STATE_VERSION = 2
 
-# reference low-pressure spool of the rotorub fan (reference.toml): polar inertia of the fan hub
-# (15.7) + LP turbine (9.2) + ten 5.8 kg blades from r = 0.4 to 1.0 m (10 x 3.02) + hollow shaft (0.44)
-DEFAULTS = {
-    "J": 55.5,  # kg m^2
-    "c_w": 0.05,  # N m s^2/rad^2: 2.5 kN m of windage at 224 rad/s
-    "Omega0": 149.52,  # rad/s: 2.8 x omega_ref (53.4 rad/s), below the first critical speed (3.49 x omega_ref)
-    "Omega1": 224.28,  # rad/s: 4.2 x omega_ref, above it
-    "t_ramp_start": 0.5,  # s
-    "t_ramp": 4.0,  # s
-    "dt_max": 1.0e-3,  # s
-}
 
-# FMI 2.0 unit definitions: name -> SI base-unit exponents
-UNITS = {
-    "rad/s": {"rad": 1, "s": -1},
-    "N.m": {"kg": 1, "m": 2, "s": -2},
-    "kg.m2": {"kg": 1, "m": 2},
-    "N.m.s2/rad2": {"kg": 1, "m": 2, "rad": -2},
-    "s": {"s": 1},
-}
+def _interface(here: Path):
+    """The staged spool_interface module (and the manifest) from the FMU's resources."""
+    manifest = json.loads((here / MANIFEST).read_text())
+    if str(here) not in sys.path:
+        sys.path.insert(0, str(here))
+    return manifest, importlib.import_module(manifest["interface"])
 
 
 class LPSpool(Fmi2Slave):
     author = "rotorub developers"
-    description = (
-        "Speed of the low-pressure spool of a turbofan: J dOmega/dt = tau_drive(t) - c_w Omega^2 + friction_torque. "
-        "The drive torque schedule makes the rub-free spool follow a run-up speed schedule exactly; the friction "
-        "torque of the blade-tip/casing contact (RotorCasingContact.fmu) slows it down."
-    )
+    description = "Speed of the low-pressure spool of a turbofan (pythonfmu flavour)"
     license = "MIT"
 
     def __init__(self, **kwargs):
@@ -86,46 +73,22 @@ class LPSpool(Fmi2Slave):
         self.version = "1.0"
         self.copyright = "rotorub developers"
         here = Path(self.resources) if self.resources else Path(__file__).parent
-        defaults = dict(DEFAULTS)
-        try:
-            defaults.update(json.loads((here / DEFAULTS_FILE).read_text()))
-        except (OSError, ValueError):
-            pass  # no build-time defaults: the module's own
-        self._specs = [
-            ("friction_torque", "Real", "input", "continuous", "N.m",
-             "External axial torque on the spool, held over each communication step: the friction torque of the "
-             "blade-tip contact (negative brakes the spin); must be finite"),
-            ("J", "Real", "parameter", "fixed", "kg.m2",
-             "Polar moment of inertia of the whole LP spool (fan hub and blades, shaft, LP turbine); > 0"),
-            ("c_w", "Real", "parameter", "fixed", "N.m.s2/rad2",
-             "Windage coefficient: windage torque c_w Omega^2 opposing the spin; >= 0"),
-            ("Omega0", "Real", "parameter", "fixed", "rad/s",
-             "Initial spin speed, held until t_ramp_start (start of the speed schedule); >= 0"),
-            ("Omega1", "Real", "parameter", "fixed", "rad/s",
-             "Final spin speed of the schedule, reached at t_ramp_start + t_ramp; >= 0"),
-            ("t_ramp_start", "Real", "parameter", "fixed", "s", "Time the run-up (or run-down) starts"),
-            ("t_ramp", "Real", "parameter", "fixed", "s",
-             "Duration of the speed change Omega0 -> Omega1 (half-cosine: zero acceleration at both ends); > 0"),
-            ("dt_max", "Real", "parameter", "fixed", "s",
-             "Largest internal RK4 step: each communication step h is split into ceil(h / dt_max) equal substeps; "
-             "> 0"),
-            ("Omega", "Real", "output", "continuous", "rad/s", "Spin speed of the LP spool"),
-            ("Omega_schedule", "Real", "output", "continuous", "rad/s",
-             "Speed the drive schedule was designed for: the speed of the spool without external torque"),
-            ("drive_torque", "Real", "output", "continuous", "N.m",
-             "Drive torque of the schedule, J dOmega_schedule/dt + c_w Omega_schedule^2 (open loop)"),
-            ("windage_torque", "Real", "output", "continuous", "N.m", "Windage torque c_w Omega^2 (brakes the spin)"),
-            ("status", "Integer", "output", "discrete", None,
-             "0 = ok, 1 = the spool stopped (Omega would fall below 0 or stop being finite; step refused), "
-             "2 = bad parameter or input (message in the log; step refused)"),
-        ]
+        manifest, itf = _interface(here)
+        self._if = itf
+        self.guid = manifest["guid"]  # derived from the interface and the script at build time
+        self.description = itf.DESCRIPTION
+        defaults = dict(itf.DEFAULTS)
+        defaults.update(manifest.get("defaults", {}))
+        self._specs = itf.SPECS
         n = len(self._specs)
-        self._values = [0.0] * n
+        self._values: list = [0.0] * n
         self._slot = {s[0]: i for i, s in enumerate(self._specs)}
         for name, value in defaults.items():
             if name in self._slot:
                 self._values[self._slot[name]] = float(value)
         self._values[self._slot["status"]] = STATUS_OK
+        self._values[self._slot["message"]] = ""
+        self._stopped = None  # (time, reason) once a step was refused because the spool stopped
         for i, spec in enumerate(self._specs):
             self._register(i, spec)
         self._phase = "instantiated"  # -> initialization -> step -> terminated
@@ -133,13 +96,14 @@ class LPSpool(Fmi2Slave):
         self._e = 0.0  # state: Omega - Omega_schedule
         self._cfg = None  # checked parameters (dict), set at the end of initialization
         self._fatal_msg = None  # configuration error: every step is refused until reset
+        self._pending = None  # a value refused at its set: the next step is refused with it
         self._warned_fixed = set()
         self._update_outputs()
 
     # ------------------------------------------------------------------ variables
     def _register(self, i: int, spec) -> None:
-        name, kind, causality, variability, _unit, desc = spec
-        cls, conv = (Real, float) if kind == "Real" else (Integer, int)
+        name, kind, causality, variability, _unit, _range, desc = spec
+        cls, conv = {"Real": (Real, float), "Integer": (Integer, int), "String": (String, str)}[kind]
         initial = Fmi2Initial.calculated if causality == "output" else None
 
         def getter(i=i, conv=conv):
@@ -155,7 +119,7 @@ class LPSpool(Fmi2Slave):
 
     def _set_value(self, i: int, value) -> None:
         """Store a value set by the master; never raises (checks happen in initialization and do_step)."""
-        name, _kind, causality, variability = self._specs[i][:4]
+        name, kind, causality, variability, _unit, rng = self._specs[i][:6]
         if causality == "output":
             self.log(f"{name}: is an output and cannot be set; value ignored", Fmi2Status.error)
             return
@@ -164,6 +128,11 @@ class LPSpool(Fmi2Slave):
                 self._warned_fixed.add(name)
                 self.log(f"{name}: fixed parameter, cannot change after initialization (reset first); new value "
                          "ignored", Fmi2Status.warning)
+            return
+        if rng is not None and not (math.isfinite(value) and rng[0] <= value <= rng[1]):
+            self.log(f"{name} = {value!r} out of range; accepted range [{rng[0]!r}, {rng[1]!r}]; value ignored "
+                     "(the next step is refused)", Fmi2Status.error)
+            self._pending = f"{name} = {value!r} out of range; accepted range [{rng[0]!r}, {rng[1]!r}]"
             return
         self._values[i] = value
 
@@ -177,21 +146,27 @@ class LPSpool(Fmi2Slave):
     def to_xml(self, model_options=None):
         """pythonfmu's description plus units, InitialUnknowns, no direct feedthrough, a default experiment."""
         root = super().to_xml(model_options or {})
+        root.set("guid", str(self.guid))
         units = Element("UnitDefinitions")
-        for name, base in UNITS.items():
+        for name, base in self._if.UNITS.items():
             SubElement(SubElement(units, "Unit", name=name), "BaseUnit", {k: str(v) for k, v in base.items()})
         children = list(root)
         cs_pos = next(i for i, el in enumerate(children) if el.tag == "CoSimulation")
         root.insert(cs_pos + 1, units)
         if root.find("DefaultExperiment") is None:
-            de = Element("DefaultExperiment", startTime="0", stopTime="5", stepSize="0.001")
+            de = Element("DefaultExperiment", {k: repr(float(v)) for k, v in self._if.DEFAULT_EXPERIMENT.items()})
             root.insert(list(root).index(root.find("ModelVariables")), de)
         for sv, spec in zip(root.find("ModelVariables"), self._specs):
             real = sv.find("Real")
-            if real is not None and real.get("start") is not None:  # pythonfmu writes %.16g: not round-trip
+            if real is None:
+                continue
+            if real.get("start") is not None:  # pythonfmu writes %.16g: not round-trip
                 real.set("start", repr(float(self._values[self._slot[spec[0]]])))
             if spec[4] is not None:
                 real.set("unit", spec[4])
+            if spec[5] is not None:
+                real.set("min", repr(float(spec[5][0])))
+                real.set("max", repr(float(spec[5][1])))
         ms = root.find("ModelStructure")
         outs = ms.find("Outputs")
         init = SubElement(ms, "InitialUnknowns")
@@ -236,6 +211,7 @@ class LPSpool(Fmi2Slave):
     # ------------------------------------------------------------------ messages
     def _report(self, status: int, msg: str) -> None:
         self._set_out("status", status)
+        self._set_out("message", msg)
         self.log(f"LPSpool: {msg}", Fmi2Status.error if status == STATUS_ERROR else Fmi2Status.discard)
 
     def _configuration_error(self, msg: str) -> None:
@@ -245,25 +221,20 @@ class LPSpool(Fmi2Slave):
 
     # ------------------------------------------------------------------ physics
     def _check_parameters(self) -> dict:
-        """The parameters, checked (raises ValueError naming the first bad one)."""
-        v = {k: float(self._v(k)) for k in ("J", "c_w", "Omega0", "Omega1", "t_ramp_start", "t_ramp", "dt_max")}
-        rules = (
-            ("J", "kg.m2", v["J"] > 0, "(0, inf)", "the polar inertia must be finite and > 0"),
-            ("c_w", "N.m.s2/rad2", v["c_w"] >= 0, "[0, inf)", "the windage coefficient must be finite and >= 0"),
-            ("Omega0", "rad/s", v["Omega0"] >= 0, "[0, inf)", "the initial spin speed must be finite and >= 0"),
-            ("Omega1", "rad/s", v["Omega1"] >= 0, "[0, inf)", "the final spin speed must be finite and >= 0"),
-            ("t_ramp_start", "s", True, "(-inf, inf)", "the start of the schedule must be finite"),
-            ("t_ramp", "s", v["t_ramp"] > 0, "(0, inf)", "the duration of the speed change must be finite and > 0"),
-            ("dt_max", "s", v["dt_max"] > 0, "(0, inf)", "the internal step limit must be finite and > 0"),
-        )
-        for name, unit, ok, rng, why in rules:
-            if not (math.isfinite(v[name]) and ok):
-                raise ValueError(f"{name}: {v[name]!r} {unit} out of range; {why}; accepted range {rng} {unit}")
+        """The parameters, checked against their declared ranges (raises ValueError naming the first bad one)."""
+        v = {}
+        for name, _kind, causality, _var, unit, rng, _desc in self._specs:
+            if causality != "parameter":
+                continue
+            x = float(self._v(name))
+            if not (math.isfinite(x) and rng[0] <= x <= rng[1]):
+                raise ValueError(f"{name} = {x!r} {unit} out of range; accepted range [{rng[0]!r}, {rng[1]!r}]")
+            v[name] = x
         return v
 
     def _schedule(self, t: float) -> tuple[float, float]:
         """(Omega_s(t), dOmega_s/dt) of the speed schedule."""
-        cfg = self._cfg if self._cfg is not None else {k: float(self._v(k)) for k in DEFAULTS}
+        cfg = self._cfg if self._cfg is not None else {k: float(self._v(k)) for k in self._if.DEFAULTS}
         x = (t - cfg["t_ramp_start"]) / cfg["t_ramp"]
         if not x > 0.0:  # also NaN: before the start
             return cfg["Omega0"], 0.0
@@ -277,7 +248,7 @@ class LPSpool(Fmi2Slave):
         """Outputs at the current communication point from (t, e)."""
         try:
             ws, wsd = self._schedule(self._t)
-            cfg = self._cfg if self._cfg is not None else {k: float(self._v(k)) for k in DEFAULTS}
+            cfg = self._cfg if self._cfg is not None else {k: float(self._v(k)) for k in self._if.DEFAULTS}
             w = ws + self._e
             self._set_out("Omega", w)
             self._set_out("Omega_schedule", ws)
@@ -312,33 +283,43 @@ class LPSpool(Fmi2Slave):
         if self._cfg is None:
             self._report(STATUS_ERROR, "do_step called before the end of initialization (fmi2ExitInitializationMode)")
             return False
+        if self._stopped is not None:
+            self._report(STATUS_ERROR, f"fmi2DoStep: the FMU ended this simulation at t = {self._stopped[0]!r} s "
+                         f"(fmi2Terminated is true): {self._stopped[1]}; call fmi2Terminate, or roll back with "
+                         "fmi2SetFMUstate to a state saved before, or fmi2Reset")
+            return False
+        if self._pending is not None:
+            msg, self._pending = self._pending, None
+            self._report(STATUS_ERROR, f"at t = {t:g} s: step refused: {msg}")
+            return False
         if not (math.isfinite(h) and h > 0):
             self._report(STATUS_ERROR, f"communication step size {h!r} s: must be finite and > 0; step refused")
             return False
-        if not math.isfinite(t):
-            self._report(STATUS_ERROR, f"communication point {t!r} s is not finite; step refused")
+        if not math.isfinite(t) or abs(t - self._t) > 1e-9 * max(abs(self._t), h):
+            self._report(STATUS_ERROR, f"currentCommunicationPoint = {t!r} does not match the FMU's time {self._t!r} "
+                         "(steps must follow each other; to go back, use fmi2SetFMUstate)")
             return False
         tau = float(self._v("friction_torque"))
-        if not math.isfinite(tau):
-            self._report(STATUS_ERROR, f"at t = {t:g} s: friction_torque: {tau!r} N.m is not finite; accepted "
-                         "range (-inf, inf) N.m; step refused, state unchanged")
-            return False
         e = self._rk4(t, h, self._e, tau)
         w = self._schedule(t + h)[0] + e
         if not (math.isfinite(w) and w >= 0):
-            self._report(STATUS_STOPPED, f"at t = {t:g} s: the spool would stop (Omega = {w!r} rad/s at the end of "
-                         f"the step, friction_torque = {tau:g} N.m); step refused, state unchanged")
+            msg = (f"the spool would stop (Omega = {w!r} rad/s at the end of the step, friction_torque = {tau:g} N.m); "
+                   "step refused, state unchanged")
+            self._stopped = (t, msg)
+            self._report(STATUS_STOPPED, f"at t = {t:g} s: {msg}")
             return False
         self._e = e
         self._t = t + h
         self._set_out("status", STATUS_OK)
+        self._set_out("message", "")
         self._update_outputs()
         return True
 
     # ------------------------------------------------------------------ FMU state (rollback)
     def _get_fmu_state(self):
         return {"version": STATE_VERSION, "values": list(self._values), "phase": self._phase, "t": self._t,
-                "e": self._e, "cfg": None if self._cfg is None else dict(self._cfg), "fatal": self._fatal_msg}
+                "e": self._e, "cfg": None if self._cfg is None else dict(self._cfg), "fatal": self._fatal_msg,
+                "stopped": None if self._stopped is None else list(self._stopped)}
 
     def _set_fmu_state(self, state):
         try:
@@ -352,6 +333,9 @@ class LPSpool(Fmi2Slave):
             self._phase, self._t, self._e = state["phase"], float(state["t"]), float(state["e"])
             self._cfg = None if state["cfg"] is None else dict(state["cfg"])
             self._fatal_msg = state["fatal"]
+            self._stopped = None if state.get("stopped") is None else (float(state["stopped"][0]),
+                                                                       str(state["stopped"][1]))
+            self._pending = None
         except Exception as exc:  # noqa: BLE001
             self._configuration_error(f"fmi2SetFMUstate: the state could not be restored ({type(exc).__name__}: "
                                       f"{exc})")
