@@ -24,6 +24,7 @@ import tempfile
 import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -61,6 +62,28 @@ def host_platform() -> str:
 
 def say(msg: str) -> None:
     print(f"[build-fmu] {msg}", file=sys.stderr, flush=True)
+
+
+@contextmanager
+def progress(what: str, label: str, how: str = ""):
+    """Say when a compilation starts and ends, and every HEARTBEAT_S seconds while it runs (a first ziglang
+    build of a target also compiles that target's C library, which otherwise looks like a hang)."""
+    t0 = time.perf_counter()
+    stop = threading.Event()
+
+    def beat() -> None:
+        while not stop.wait(HEARTBEAT_S):
+            say(f"{what}: {label}: still compiling ({time.perf_counter() - t0:.0f} s; a first ziglang build of a "
+                "target also compiles its C library, about a minute for Windows)")
+
+    say(f"{what}: {label}: compiling{' ' + how if how else ''}")
+    thread = threading.Thread(target=beat, daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        stop.set()
+    say(f"{what}: {label}: done in {time.perf_counter() - t0:.1f} s")
 
 
 def _compiler_identity(command: tuple[str, ...], kind: str) -> str:
@@ -114,18 +137,6 @@ def compile_platforms(sources: Path, c_files: tuple[str, ...], identifier: str, 
                 key.update(f.name.encode() + b"\0" + f.read_bytes())
         jobs.append((plat, compiler, flags, libs, key.hexdigest()[:32]))
 
-    running: dict[str, float] = {}
-    lock = threading.Lock()
-    stop = threading.Event()
-
-    def heartbeat() -> None:
-        while not stop.wait(HEARTBEAT_S):
-            with lock:
-                now = time.perf_counter()
-                busy = ", ".join(f"{p} ({now - t0:.0f} s)" for p, t0 in running.items())
-            if busy:
-                say(f"{what}: still compiling {busy}; a first ziglang build of a target also compiles its C library")
-
     def one(job) -> str:
         plat, compiler, flags, libs, key = job
         name = f"{identifier}{PLATFORMS[plat].suffix}"
@@ -136,35 +147,21 @@ def compile_platforms(sources: Path, c_files: tuple[str, ...], identifier: str, 
             shutil.copy2(cached, out)
             say(f"{what}: {plat}: from the cache ({cached.parent.name[:12]})")
             return plat
-        t0 = time.perf_counter()
-        with lock:
-            running[plat] = t0
-        say(f"{what}: {plat}: compiling with {compiler.name}"
-            + (f" for {PLATFORMS[plat].zig_target}" if compiler.kind == "zig" else ""))
-        try:
-            with tempfile.TemporaryDirectory(prefix="rotorub_cc_") as work:
-                # in a folder of its own: a Windows build also leaves an import library and debug data behind
-                target = Path(work) / name
-                cmd = [*compiler.command, *flags, f"-I{sources}", "-o", str(target),
-                       *(str(sources / s) for s in c_files), *libs]
-                r = subprocess.run(cmd, capture_output=True, text=True, cwd=work)
-                if r.returncode != 0 or not target.exists():
-                    raise NativeBuildError(f"{what} for {plat}: {compiler.name} failed:\n{r.stderr.strip()[-4000:]}")
-                cached.parent.mkdir(parents=True, exist_ok=True)
-                tmp = cached.with_suffix(cached.suffix + f".{os.getpid()}.{threading.get_ident()}.tmp")
-                shutil.copy2(target, tmp)
-                os.replace(tmp, cached)  # another build may be writing the same key: whole files only
-                shutil.copy2(target, out)
-        finally:
-            with lock:
-                running.pop(plat, None)
-        say(f"{what}: {plat}: done in {time.perf_counter() - t0:.1f} s")
+        how = f"with {compiler.name}" + (f" for {PLATFORMS[plat].zig_target}" if compiler.kind == "zig" else "")
+        with progress(what, plat, how), tempfile.TemporaryDirectory(prefix="rotorub_cc_") as work:
+            # in a folder of its own: a Windows build also leaves an import library and debug data behind
+            target = Path(work) / name
+            cmd = [*compiler.command, *flags, f"-I{sources}", "-o", str(target), *(str(sources / s) for s in c_files),
+                   *libs]
+            r = subprocess.run(cmd, capture_output=True, text=True, cwd=work)
+            if r.returncode != 0 or not target.exists():
+                raise NativeBuildError(f"{what} for {plat}: {compiler.name} failed:\n{r.stderr.strip()[-4000:]}")
+            cached.parent.mkdir(parents=True, exist_ok=True)
+            tmp = cached.with_suffix(cached.suffix + f".{os.getpid()}.{threading.get_ident()}.tmp")
+            shutil.copy2(target, tmp)
+            os.replace(tmp, cached)  # another build may be writing the same key: whole files only
+            shutil.copy2(target, out)
         return plat
 
-    beat = threading.Thread(target=heartbeat, daemon=True)
-    beat.start()
-    try:
-        with ThreadPoolExecutor(max_workers=max(1, min(len(jobs), os.cpu_count() or 1))) as pool:
-            return list(pool.map(one, jobs))
-    finally:
-        stop.set()
+    with ThreadPoolExecutor(max_workers=max(1, min(len(jobs), os.cpu_count() or 1))) as pool:
+        return list(pool.map(one, jobs))

@@ -147,6 +147,8 @@ def _kernel_binaries(pkg: Path, platforms: tuple[str, ...] | None) -> list[str]:
     from rotorub_model import kernel
     from rotorub_model.kernel.compiler import CompilerError, host_platform_tag, zig_command
 
+    from .native_compile import progress
+
     host = host_platform_tag()
     host_fmi = next((f for f, tag in KERNEL_PLATFORMS.items() if tag == host), None)
     wanted = list(platforms) if platforms is not None else [f for f in KERNEL_PLATFORMS if f == host_fmi
@@ -163,7 +165,8 @@ def _kernel_binaries(pkg: Path, platforms: tuple[str, ...] | None) -> list[str]:
                 out.parent.mkdir(parents=True, exist_ok=True)
                 shutil.copy2(kernel.cache_dir() / f"kernel-{kernel.source_id()}-{tag}.so", out)
             else:
-                kernel.build(out, target=fmi)
+                with progress("pythonfmu FMU kernel", fmi, "with ziglang"):
+                    kernel.build(out, target=fmi)
         except CompilerError as exc:
             if platforms is not None:
                 raise BuildError(f"kernel for {fmi}: {exc}") from None

@@ -194,6 +194,10 @@ def load() -> ctypes.CDLL:
         lib = _open(cached, sid)
         if lib is not None:
             return lib
+    import sys
+
+    print(f"[rotorub] compiling the C kernel once into {cached.parent} (a second with the system compiler, up to "
+          "a quarter of a minute with ziglang the first time)", file=sys.stderr, flush=True)
     build(cached)
     lib = _open(cached, sid)
     if lib is None:
