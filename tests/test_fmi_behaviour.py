@@ -614,6 +614,21 @@ def test_quasi_static_penetration_beyond_max_penetration_is_a_divergence(inst):
     assert inst.real("gap_min") < -0.3e-3  # the outputs are that solution's
 
 
+def test_quasi_static_point_without_solution_after_an_unstable_one(inst):
+    """The main job's FMU sweep at g0 = 0.33 mm (2D): at 3.70 omega_ref the balanced solution is unstable
+    (status 3); at 3.87 Newton finds none: that step is fmi2Discard with status 1 (not the 3 the last good step
+    left), and fmi2Terminated, which is what a sweep rolls back on."""
+    g0, speeds = 1.6 * 0.00517474459231002 * (3 / 15) ** 2, np.linspace(2.6923, 4.2923, 20)
+    assert inst.init(mode=2, formulation=1, g0=g0, Omega=speeds[0] * 53.4, imbalance=0.022) <= WARNING
+    for sp in speeds[:14]:  # the sweep warm-starts each point from the last
+        assert inst.set_real(Omega=sp * 53.4) == OK and inst.step(1.0) == OK
+    assert inst.integer("status") == 3
+    assert inst.set_real(Omega=speeds[14] * 53.4) == OK
+    assert inst.step(1.0) == DISCARD
+    assert inst.integer("status") == 1 and "no balanced static solution" in inst.message()
+    assert _terminated(inst)
+
+
 def test_quasi_static_reports_an_unstable_solution_in_status(inst):
     assert inst.init(mode=2, formulation=1, g0=0.2e-3, Omega=3.3 * 53.4, imbalance=0.022) <= WARNING
     assert inst.step(0.1) == OK

@@ -557,8 +557,9 @@ fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real h, fmi2Boolean no
     }
     c->last_good = c->time + model_time_advanced(c->m);
     if (s == fmi2Discard) {
-        /* the model cannot go on from here: the run ends (fmi2Terminated), unless the master rolls back */
-        if (c->i[MODEL_INFO.vr_status] == STATUS_OK) c->i[MODEL_INFO.vr_status] = STATUS_DIVERGED;
+        /* the model cannot go on from here: the run ends (fmi2Terminated), unless the master rolls back; the
+         * status says so whatever the last good step reported (quasi_static: 3, unstable) */
+        c->i[MODEL_INFO.vr_status] = STATUS_DIVERGED;
         c->stopped = 1;
         snprintf(c->stop_reason, sizeof c->stop_reason, "%s", msg);
         return fail(c, s, "fmi2DoStep at t = %s s: %s (fmi2Terminated = true: the run ends at the last successful "
