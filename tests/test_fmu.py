@@ -380,3 +380,32 @@ def test_every_speed_band_of_the_validity_range_steps(fmu, unzipped, formulation
             s.set(Omega=float(w))
             s.step(None, 1e-4)
             assert s.get("status") == 0 and s.get("dt_internal") > 0.0
+
+
+DANGLING_LOGGER = r'''
+import gc, sys
+import fmpy
+from fmu_src.harness.fmi_run import simulate
+fmu = sys.argv[1]
+simulate(fmu, stop_time=0.01, output_interval=1e-3)
+gc.collect()
+# fmpy's default callbacks log through its native proxy: it must not point at a freed thunk of ours
+r = fmpy.simulate_fmu(fmu, start_values={"g0": 0.2e-3, "Omega": 176.2, "imbalance": 0.022, "max_penetration": 0.2e-3},
+                      stop_time=5.0, output_interval=1e-3, output=["gap_min", "status"])
+print("ended at", r["time"][-1])
+'''
+
+
+def test_simulate_leaves_no_dangling_logger_in_fmpy(native_fmu, tmp_path):
+    """fmpy.simulate_fmu(logger=f) leaves fmpy's process-wide log proxy pointing at f's ctypes thunk, freed
+    when the run ends; the next FMU logging through fmpy's default callbacks (the native FMU logs every
+    refusal) then jumped into freed memory: a segfault of the whole suite, found by a helper with gdb and
+    valgrind. fmu_src.harness.fmi_run.simulate drives an instance with callbacks of its own instead. In a
+    subprocess: the failure is a crash."""
+    import subprocess
+    import sys
+
+    script = tmp_path / "dangling.py"
+    script.write_text(DANGLING_LOGGER)
+    r = subprocess.run([sys.executable, str(script), str(native_fmu)], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and "ended at" in r.stdout, (r.returncode, r.stderr[-2000:])

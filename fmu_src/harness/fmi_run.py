@@ -63,15 +63,22 @@ def simulate(fmu: str | Path, **kwargs) -> np.ndarray:
     """``fmpy.simulate_fmu`` with logging on; a failure raises :class:`FMUError` with the FMU's messages."""
     from fmpy import simulate_fmu
 
-    log = _Log()
-    kwargs.setdefault("debug_logging", True)
+    # Not simulate_fmu(logger=...): fmpy's native log proxy keeps one process-wide pointer to that call's
+    # ctypes thunk, which is freed when the run ends, and the next FMU that logs through fmpy's default
+    # callbacks (the native FMU logs every refusal, logging on or off) jumps into freed memory: a
+    # segfault a few hundred tests later. Our own instance has callbacks of its own, alive as long as it.
+    kwargs.pop("debug_logging", None)
     if kwargs.get("start_values"):
         kwargs["start_values"] = enum_values(fmu, kwargs["start_values"])
+    slave = Slave(fmu, instance_name="simulate", initialize=False)
+    log = slave.log
     try:
-        result = simulate_fmu(str(fmu), logger=log, **kwargs)
+        result = simulate_fmu(slave.unzip_dir, fmu_instance=slave.fmu, terminate=False, **kwargs)
+        refused = [m for st, m in log.records if st >= 2]  # fmi2Discard, fmi2Error, fmi2Fatal
     except Exception as exc:  # noqa: BLE001 - re-raised with the FMU's own words
         raise FMUError(str(exc), log.problems()) from exc
-    refused = [m for st, m in log.records if st >= 2]  # fmi2Discard, fmi2Error, fmi2Fatal
+    finally:
+        slave.close()
     if refused:
         t = float(result["time"][-1]) if len(result) else float("nan")
         raise FMUError(f"simulation stopped at t = {t:g} s", refused)

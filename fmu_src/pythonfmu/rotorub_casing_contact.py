@@ -57,6 +57,10 @@ def _load(resources: Path) -> tuple[dict, object, object]:
     lib = Lib()
     for name in _LIB_MODULES:
         setattr(lib, name.rpartition(".")[2], importlib.import_module(f"{pkg}.{name}"))
+    # loaded now, from this instance's resources: the modules are shared by every instance of this build,
+    # and a first instance whose configuration is refused (its folder then deleted by the master) would
+    # otherwise leave the lazy load to find its sources gone
+    lib.kernel.load()
     return manifest, lib, importlib.import_module(manifest["interface"])
 
 
