@@ -67,3 +67,23 @@ def test_interrupted_sweep_resumes(model, serial, tmp_path, monkeypatch):
     res = run_stability_map(model, "3D", SPEEDS, G0S, executor="serial", out=tmp_path, progress=False)
     assert len(counted) == 2  # only the two missing rows were computed
     _same(res, serial)
+
+
+def _blas_threads(tag: int) -> dict[str, np.ndarray]:
+    from threadpoolctl import threadpool_info
+
+    pools = [p["num_threads"] for p in threadpool_info() if p.get("user_api") == "blas"]
+    return {"tag": np.array(tag), "threads": np.array(max(pools) if pools else 1)}
+
+
+def test_pool_tasks_run_blas_on_one_thread():
+    """Each worker is one core's worth of work: a task whose BLAS started a thread per core
+    made the 18-blade maps 5-20x slower (issue 18.1). The limit must hold in the worker."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    from rotorub_model.analyses.sweeps import run_tasks
+
+    with ProcessPoolExecutor(max_workers=2) as ex:
+        res = run_tasks(_blas_threads, [{"tag": i} for i in range(4)], executor=ex, progress=False)
+    assert [int(r["tag"]) for r in res] == [0, 1, 2, 3]
+    assert all(int(r["threads"]) == 1 for r in res), [int(r["threads"]) for r in res]
