@@ -172,3 +172,23 @@ def test_transient_records_outputs(model):
         run_transient(model, c, 100.0, t_end=-1)
     with pytest.raises(ParameterError, match="omega"):
         run_transient(model, c, float("nan"))
+
+
+def test_map_cell_indicators_equal_the_full_stability_analysis(model):
+    """The maps' eigenvalue-only path (stability_indicators) gives the same largest real part and
+    sum of positive real parts as stability_of, stable and unstable, 2D and 3D."""
+    from rotorub_model.analyses.stability import stability_indicators
+
+    seen = set()
+    for form in ("2D", "3D"):
+        for speed, g0 in ((3.3, 0.2e-3), (3.45, 0.8e-3), (3.4, 0.05e-3)):
+            omega = speed * model.params.normalisation.omega_ref
+            c = make_contact(model, form, g0=g0)
+            st = solve_static(model, c, omega)
+            assert st.converged
+            sb = stability_of(model, c, omega, st.q)
+            mx, sp = stability_indicators(model, c, omega, st.q)
+            assert mx == pytest.approx(sb.max_real, rel=1e-9, abs=1e-9)
+            assert sp == pytest.approx(sb.sum_positive_real, rel=1e-9, abs=1e-9)
+            seen.add(sb.stable)
+    assert seen == {True, False}, "the points must cover stable and unstable cells"

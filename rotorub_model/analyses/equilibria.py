@@ -60,7 +60,7 @@ class Equilibria:
         self.follow_iterations = 10
         self.n = model.n_dofs
         self._contacts: dict[float, ContactModel] = {}
-        self._Minv = np.linalg.inv(model.M)
+        self._Minv = model.M_inv
         T, _ = model.disk_maps
         self._T2 = T[:2]
         self._speed_cache = None

@@ -144,7 +144,7 @@ def first_order(model: Model, omega: float, K_extra: np.ndarray | None = None,
     C = model.D + model.G(omega)
     if C_extra is not None:
         C = C - C_extra
-    Minv = np.linalg.inv(model.M)
+    Minv = model.M_inv
     A = np.zeros((2 * n, 2 * n))
     A[:n, n:] = np.eye(n)
     A[n:, :n] = -Minv @ K

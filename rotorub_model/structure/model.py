@@ -76,6 +76,11 @@ class Model:
         return self.dofs.index(name)
 
     @cached_property
+    def M_inv(self) -> np.ndarray:
+        """M^-1 (every first-order system and eigen-analysis needs it; the model's matrices do not change)."""
+        return np.linalg.inv(self.M)
+
+    @cached_property
     def disk_maps(self) -> tuple[np.ndarray, np.ndarray]:
         """(T, R), 3 x n: fan-disk translation and rotation vector from q."""
         p = self.params
