@@ -192,3 +192,20 @@ def test_map_cell_indicators_equal_the_full_stability_analysis(model):
             assert sp == pytest.approx(sb.sum_positive_real, rel=1e-9, abs=1e-9)
             seen.add(sb.stable)
     assert seen == {True, False}, "the points must cover stable and unstable cells"
+
+
+def test_transient_divergence_depth_is_the_parameter_files():
+    """contact.max_penetration from the parameter file sets the library transient's divergence
+    depth (it was a fixed 10 mm): the same interference diverges with a 0.02 mm liner and runs
+    with the reference's 3 mm."""
+    from rotorub_model.analyses.transient import run_transient
+    from rotorub_model.structure.params import reference_parameters
+
+    runs = {}
+    for depth in (2e-5, None):
+        p = reference_parameters() if depth is None else reference_parameters().replace(contact={"max_penetration": depth})
+        m = build_model(p)
+        c = make_contact(m, "2D", g0=-5e-5)
+        runs[depth] = run_transient(m, c, 0.5 * p.normalisation.omega_ref, t_end=0.01, t_ramp=0.0, me=0.0)
+    assert runs[2e-5].diverged and "0.02 mm" in runs[2e-5].message, runs[2e-5].message
+    assert not runs[None].diverged, runs[None].message

@@ -219,7 +219,7 @@ def _orbits_2d(eq: Equilibria, branch: Branch, omega: float, max_orbits: int) ->
     q = p.q
     q0, v0 = eq.unstable_start(q, omega, g0, p.mu, 1e-5)
     tr = run_transient(eq.model, eq.contact(g0), omega, t_end=40.0, t_ramp=0.0, me=eq.me, q0=q0, v0=v0,
-                       record_dt=5e-4, max_penetration=0.01)
+                       record_dt=5e-4)
     if tr.diverged or len(tr.q) < 100:
         return [OrbitBranch(eq.formulation, omega, [], f"the transient at g0 = {g0:.4g} m diverged: no orbit")]
     d = tr.q[-4000:] @ eq._T2.T

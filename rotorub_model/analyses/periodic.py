@@ -82,7 +82,7 @@ class Shooting:
             raise ParameterError(f"steps_per_period: {steps_per_period} out of range; accepted range [16, inf)")
         self.eq, self.omega, self.N = eq, float(omega), int(steps_per_period)
         self.n = eq.n
-        self._cd = CentralDifference(eq.model, eq.base, dt=None, t_ramp=0.0, max_penetration=0.01,
+        self._cd = CentralDifference(eq.model, eq.base, dt=None, t_ramp=0.0,
                                      omega_max_for_dt=self.omega)
         T, _ = eq.model.disk_maps
         self._T2 = T[:2]

@@ -23,8 +23,9 @@ w_max the largest frequency of the linearised system with every contact closed
 (all blades in full contact). By default dt = 0.5 x that limit; a user dt above the
 limit is refused.
 
-Divergence: the run stops when a gap falls below -``max_penetration`` (10 mm by
-default: the blade has gone through the liner, the penalty model is meaningless)
+Divergence: the run stops when a gap falls below -``max_penetration`` (by default the parameter
+file's contact.max_penetration, 3 mm in the reference: the blade has gone through the liner, the
+penalty model is meaningless)
 or a value stops being finite; the result says so and when.
 """
 
@@ -72,9 +73,11 @@ class CentralDifference:
     """
 
     def __init__(self, model: Model, contact: ContactModel, dt: float | None = None, t_ramp: float = 1.0,
-                 max_penetration: float = 0.01, omega_max_for_dt: float | None = None):
+                 max_penetration: float | None = None, omega_max_for_dt: float | None = None):
         if t_ramp is None or not math.isfinite(t_ramp) or t_ramp < 0:
             raise ParameterError(f"t_ramp: {t_ramp} out of range; accepted range [0, inf) s")
+        if max_penetration is None:  # the parameter file's (contact.max_penetration: an abradable liner's depth)
+            max_penetration = model.params.contact.max_penetration
         if not math.isfinite(max_penetration) or max_penetration <= 0:
             raise ParameterError(f"max_penetration: {max_penetration} out of range; accepted range (0, inf) m")
         self.model = model
@@ -335,7 +338,7 @@ def run_transient(
     segment: float = 1e-3,
     q0: np.ndarray | None = None,
     v0: np.ndarray | None = None,
-    max_penetration: float = 0.01,
+    max_penetration: float | None = None,
     progress: bool = False,
     hold: float | None = None,
 ) -> TransientResult:
@@ -431,7 +434,7 @@ def run_transient(
         phi = om[0] * t_rec[0] + np.concatenate([[0.0], np.cumsum(0.5 * (om[1:] + om[:-1]) * np.diff(t_rec))])
     outs = outputs_from_q(model, integ.contact, q_rec, phi, rotating=rec_out[:written])
     msg = (
-        f"diverged at t = {integ.t:.4f} s: penetration beyond {max_penetration * 1e3:g} mm"
+        f"diverged at t = {integ.t:.4f} s: penetration beyond {integ.max_penetration * 1e3:g} mm"
         if integ.diverged
         else f"completed {t_end:g} s in {done_total} steps of {dt_:.3e} s"
     )
