@@ -332,6 +332,26 @@ def test_rigid_rotor_damped_critical_speed():
     np.testing.assert_allclose(r.peak_amplitudes[0], me / (2 * zeta * np.sqrt(1 - zeta**2) * m_total), rtol=1e-5)
 
 
+def test_rigid_rotor_damping_ratio_is_the_fixed_frames():
+    """At the critical speed the forward mode stands still in the rotating frame (|lambda| ~
+    |Re lambda|): the damping ratio must still be the Jeffcott rotor's zeta, the one an
+    observer of the whirl sees, not ~1 from the rotating-frame eigenvalue."""
+    p0 = rigid_rotor_params()
+    w_n = run_modes(build_model(p0), 0.0).eigenvalues[0].imag
+    m_total, _, _ = rigid_rotor_closed_form(p0)
+    zeta = 0.02
+    model = build_model(rigid_rotor_params(c_bearing=zeta * m_total * w_n))
+    # 2 % below it: exactly at it the rotating frequency is 0 and forward/backward labels tie
+    r = run_modes(model, 0.98 * w_n / model.params.normalisation.omega_ref)
+    i = int(np.argmin(np.abs(r.eigenvalues.imag)))
+    assert abs(r.eigenvalues[i].imag) < 0.03 * w_n, r.eigenvalues[i]
+    assert r.harmonic[i] == 1
+    # rotating-frame reading (the old one) would be ~0.7 here
+    assert -r.eigenvalues[i].real / abs(r.eigenvalues[i]) > 0.5
+    # the damped Jeffcott eigenvalue in the fixed frame is -zeta w_n + i w_n sqrt(1 - zeta^2)
+    np.testing.assert_allclose(r.damping_ratio[i], zeta, rtol=1e-4)
+
+
 # ---------------------------------------------------------------------------
 # 6. matrix structure of the reference model
 # ---------------------------------------------------------------------------

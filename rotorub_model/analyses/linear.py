@@ -173,7 +173,7 @@ def harmonic_weights(model: Model, phi: np.ndarray) -> dict[int, float]:
         w[n] = w.get(n, 0.0) + m * abs(x + 1j * y) ** 2 / 4
         w[-n] = w.get(-n, 0.0) + m * abs(x - 1j * y) ** 2 / 4
     p = model.params
-    N, nb = p.blades.count, p.blades.n_ritz
+    N, nb = p.blades.count, p.blades.dofs
     bl = phi[model.slices["blades"]].reshape(N, nb)
     mb = Md[model.slices["blades"]].reshape(N, nb)[0]
     coef = np.fft.fft(bl, axis=0) / N  # coef[k] multiplies exp(+i k a_j)
@@ -209,11 +209,15 @@ class ModesResult:
     def plot(self, path: str | Path) -> Path:
         plt = pyplot()
         fig, ax = plt.subplots(figsize=(7, 4))
-        ax.scatter(self.eigenvalues.real, self.eigenvalues.imag / (2 * np.pi), c=np.abs(self.harmonic), cmap="viridis")
+        h = np.abs(self.harmonic)
+        sc = ax.scatter(self.eigenvalues.real, self.eigenvalues.imag / (2 * np.pi), c=h, cmap="viridis",
+                        vmin=0, vmax=max(int(h.max()), 1))
+        cb = fig.colorbar(sc, ax=ax)
+        cb.set_label("|nodal diameter index|")
         ax.axvline(0, color="k", lw=0.8)
         ax.set_xlabel("real part [1/s]")
         ax.set_ylabel("rotating-frame frequency [Hz]")
-        ax.set_title(f"Eigenvalues at Ω = {self.speed:.3g} (colour: |nodal diameter|)")
+        ax.set_title(f"Eigenvalues at Ω = {self.speed:.3g} Ω_ref")
         ax.grid(alpha=0.3)
         return save_figure(fig, path)
 
