@@ -42,7 +42,7 @@ def blade_block(p):
     """(K, M, S2 + N2, G1) on the dofs of blade 1, shaft dofs clamped (sub-block)."""
     mats = bladed_disk_matrices(p)
     ns = 2 * p.shaft.n_ritz
-    sl = slice(ns, ns + p.blades.n_ritz)
+    sl = slice(ns, ns + p.blades.dofs)
     return mats.K[sl, sl], mats.M[sl, sl], (mats.S2 + mats.N2)[sl, sl], mats.G1[sl, sl]
 
 
@@ -115,7 +115,7 @@ def test_cantilever_roots_match_tabulated_constants():
 
 
 def test_blade_block_of_assembled_model_is_the_component_block(ref_params):
-    p = ref_params.replace(blades={"n_ritz": 3})
+    p = ref_params.replace(blades={"n_ritz": 3, "n_modes": 3})
     m = build_model(p)
     K, M, _, _ = blade_block(p)
     i = m.index("blade1.b1")
@@ -125,7 +125,7 @@ def test_blade_block_of_assembled_model_is_the_component_block(ref_params):
 
 
 def test_cantilever_two_ritz_functions_upper_bound(ref_params):
-    p = ref_params.replace(blades={"n_ritz": 2})
+    p = ref_params.replace(blades={"n_ritz": 2, "n_modes": 2})
     K, M, _, _ = blade_block(p)
     w = np.sqrt(eigh(K, M, eigvals_only=True)) / beam_unit(p)
     exact = cantilever_beta_l()[0] ** 2
@@ -136,7 +136,7 @@ def test_cantilever_two_ritz_functions_upper_bound(ref_params):
 
 
 def test_cantilever_six_ritz_functions_two_modes(ref_params):
-    p = ref_params.replace(blades={"n_ritz": 6})
+    p = ref_params.replace(blades={"n_ritz": 6, "n_modes": 6})
     K, M, _, _ = blade_block(p)
     w = np.sqrt(eigh(K, M, eigvals_only=True)) / beam_unit(p)
     b1, b2 = cantilever_beta_l()
@@ -158,7 +158,7 @@ WRIGHT_FLAP = {0: 3.5160, 1: 3.6816, 2: 4.1373, 3: 4.7973, 4: 5.5850, 5: 6.4495}
 
 
 def _rotating_blade(stagger: float, speed_bar: float):
-    p = reference_parameters().replace(blades={"stagger_deg": stagger, "hub_radius": 1e-9, "n_ritz": 6})
+    p = reference_parameters().replace(blades={"stagger_deg": stagger, "hub_radius": 1e-9, "n_ritz": 6, "n_modes": 6})
     u = beam_unit(p)
     K, M, KS, _ = blade_block(p)
     omega = speed_bar * u
@@ -593,7 +593,7 @@ PMAT = np.diag([1.0, 1.0, 0.0])
 
 @pytest.fixture(scope="module")
 def kinematics():
-    p = reference_parameters().replace(blades={"n_ritz": 3, "count": 5, "stagger_deg": 30.0})
+    p = reference_parameters().replace(blades={"n_ritz": 3, "n_modes": 3, "count": 5, "stagger_deg": 30.0})
     kin = ExactBladeKinematics(p)
     return p, kin, bladed_disk_matrices(p), kin.jacobian()
 

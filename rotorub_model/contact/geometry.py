@@ -16,8 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import kernel
+from ..structure.blades import blade_functions
 from ..structure.model import Model
-from ..structure.ritz import cantilever_basis
 
 
 @dataclass
@@ -45,8 +45,8 @@ def geometry_spec(model: Model, n_points: int, theta: float, chord: float, rotat
         "n": model.n_dofs, "nb": p.blades.count, "np": n_points, "rotations": int(bool(rotations)),
         "r_tip": p.blades.tip_radius, "stagger": float(np.radians(p.blades.stagger_deg)), "theta": float(theta),
         "chord": float(chord), "z_cg": p.casing.z_cg, "blade_dof0": model.slices["blades"].start,
-        "n_ritz": p.blades.n_ritz,
-        "psi_tip": np.ascontiguousarray(cantilever_basis(p.blades.length, p.blades.length, p.blades.n_ritz)[0]),
+        "n_ritz": p.blades.dofs,  # the kernel's name: the blade functions per blade (polynomials or modes)
+        "psi_tip": np.ascontiguousarray(blade_functions(p, p.blades.length)[0]),
         "casing_dof0": model.slices["casing"].start, "modes": np.asarray(p.casing.modes, dtype=np.intc),
         "T": np.ascontiguousarray(T, dtype=float), "Rot": np.ascontiguousarray(R, dtype=float),
     }

@@ -88,8 +88,16 @@ class BladeParams:
     E: float = _f(0, lo_open=True, doc="Young's modulus [Pa]")
     rho: float = _f(0, lo_open=True, doc="density [kg/m^3]")
     stagger_deg: float = _f(0, 90, doc="stagger angle from the axial direction [deg]")
-    n_ritz: int = _f(1, 12, integer=True, doc="polynomial Ritz functions per blade")
+    n_ritz: int = _f(1, 12, integer=True, doc="polynomial Ritz functions per blade (the accuracy of its modes)")
     damping_ratio: float = _f(0, 0.5, doc="modal damping ratio of blade bending (rotating frame)")
+    n_modes: int = _f(1, 12, integer=True, default=2,
+                      doc="blade modes kept (the lowest cantilever modes of the n_ritz functions; at most n_ritz): "
+                          "the dofs per blade, and what sets the explicit time step")
+
+    @property
+    def dofs(self) -> int:
+        """Generalised coordinates per blade: the modes kept (all n_ritz functions when n_modes >= n_ritz)."""
+        return min(self.n_modes, self.n_ritz)
 
     @property
     def tip_radius(self) -> float:

@@ -22,7 +22,7 @@ def reference_geometry(model, formulation: str, theta: float = 0.0, chord: float
     T, Rot = model.disk_maps
     cs = model.slices["casing"]
     bl = model.slices["blades"]
-    nb = p.blades.n_ritz
+    nb = p.blades.dofs
     P_ = 1 if formulation == "2D" else 2
     pts = np.zeros((N, P_, 3))
     nor = np.zeros((N, P_, 3))
