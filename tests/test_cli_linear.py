@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -128,17 +129,26 @@ def bad_params_file(write_params):
 @pytest.mark.parametrize(
     "args, needles",
     [
-        (["response", "--speed-min", "-1"], ["response", "speed range"]),
-        (["response", "--speed-min", "5", "--speed-max", "2"], ["speed range"]),
-        (["response", "--speed-max", "nan"], ["speed range"]),
+        (["response", "--speed-min", "-1"], ["response", "--speed-min", "out of range", "[0, 12]"]),
+        (["response", "--speed-min", "5", "--speed-max", "2"], ["--speed-min", "below --speed-max"]),
+        (["response", "--speed-max", "nan"], ["--speed-max", "out of range"]),
         (["response", "--n-speeds", "3"], ["n_speeds", "range"]),
-        (["modes", "--speed", "-1"], ["modes", "speed", "range"]),
-        (["campbell", "--speed-max", "-2"], ["campbell", "speed range"]),
+        (["modes", "--speed", "-1"], ["modes", "--speed", "range"]),
+        (["campbell", "--speed-max", "-2"], ["campbell", "--speed-max", "out of range"]),
+        # issue 18.6: each of these ran (or traced back) before
+        (["campbell", "--n-speeds", "0"], ["campbell", "--n-speeds", "[2, inf)"]),
+        (["modes", "--speed", "99"], ["--speed", "normalisation.speed_max = 12"]),
+        (["continuation", "--speed", "-1"], ["continuation", "--speed", "out of range"]),
+        (["transient", "--g0", "-1"], ["transient", "--g0", "contact.max_penetration"]),
+        (["transient", "--t-end", "0"], ["transient", "--t-end", "(0, inf) s"]),
     ],
 )
 def test_bad_arguments_in_process(tmp_path, capsys, args, needles):
     out = tmp_path / "never"
+    t0 = time.perf_counter()
     assert main([*args, "--out", str(out)]) != 0
+    # refused before any work (continuation --speed -1 used to compute 8 s of maps first)
+    assert time.perf_counter() - t0 < 2.0
     captured = capsys.readouterr()
     _one_error_line(captured.err, *needles)
     assert captured.out == ""
@@ -164,7 +174,7 @@ def test_bad_input_subprocess(tmp_path, bad_params_file):
     _one_error_line(proc.stderr, "nope.toml", "cannot be read")
     proc = _cli("response", "--speed-min", "-1", "--out", str(tmp_path / "x"))
     assert proc.returncode != 0
-    _one_error_line(proc.stderr, "speed range")
+    _one_error_line(proc.stderr, "--speed-min", "out of range")
     assert not (tmp_path / "x").exists(), "no output folder on bad input"
 
 

@@ -223,17 +223,13 @@ def run_fmu_transient(fmu: str | Path, unzip: str, formulation: str, g0: float, 
                   rec[:m, 2 * nb + 1:2 * nb + 3], status[: m + (1 if m < n else 0)], time.perf_counter() - t0)
 
 
-def force_growth(r: FMURun, t_from: float = 2.0, window: float = 2.0) -> float | None:
-    """Growth of the oscillation of the total normal force after the ramp: its peak-to-peak range
-    over the last ``window`` seconds divided by that over [t_from, t_from + window]. The FMU's
-    counterpart of the library's state-envelope growth (studies.growth_after_ramp), with the same
-    verdict threshold (10x = diverged); None if the run is too short."""
-    if len(r.t) == 0 or r.t[-1] < t_from + 2 * window:
-        return None
-    total = r.F_N.sum(axis=1)
-    first = (r.t >= t_from) & (r.t < t_from + window)
-    last = r.t >= r.t[-1] - window
-    return float(np.ptp(total[last]) / max(np.ptp(total[first]), 1e-9))
+def force_growth(r: FMURun) -> dict:
+    """Growth of the oscillation of the total normal force at the end of the run: the FMU's counterpart of
+    the library's state-envelope growth (rotorub_model.app.studies.envelope_growth, on the force's
+    peak-to-peak range), judged by the same verdict (studies.diverging)."""
+    from rotorub_model.app.studies import NO_GROWTH, envelope_growth
+
+    return envelope_growth(r.t, r.F_N.sum(axis=1), kind="ptp") if len(r.t) else dict(NO_GROWTH)
 
 
 def _rel_diff(a: np.ndarray, b: np.ndarray) -> float:
@@ -263,6 +259,7 @@ def transient_pair(fmu: str | Path, model, speed: float, g0: float, out: str | P
                    t_ramp: float = 1.0, h: float = H_TRANSIENT, progress: bool = False) -> dict:
     """Section 6 through the FMU: 2D and 3D at (speed, g0), imbalance ramped over t_ramp by the master."""
     from rotorub_model.analyses.transient import run_transient
+    from rotorub_model.app.studies import diverging
     from rotorub_model.contact import make_contact
 
     out = Path(out)
@@ -285,7 +282,8 @@ def transient_pair(fmu: str | Path, model, speed: float, g0: float, out: str | P
         i1 = min(int(round(1.0 / h)) - 1, len(r.t) - 1)
         growth = force_growth(r)
         summary[f] = {
-            "diverged": bool((len(r.status) > len(r.t) and r.status[-1] == 1) or (growth or 0.0) > 10.0),
+            "diverged": bool((len(r.status) > len(r.t) and r.status[-1] == 1)
+                             or diverging(growth)),
             "force_oscillation_growth_after_ramp": growth,
             "t_reached_s": float(r.t[-1]) if len(r.t) else 0.0,
             "blades_in_contact_at_1s": int((r.F_N[i1] > 0).sum()) if len(r.t) else 0,

@@ -39,6 +39,45 @@ def arg(*args, **kwargs):
     return deco
 
 
+def check_arguments(ns: argparse.Namespace, p) -> None:
+    """Every numeric argument against the model's validity, before any work (one-line ParameterError).
+
+    Speeds are normalised and valid in [0, normalisation.speed_max] of the parameter file; counts of
+    speeds or clearances are at least 2; times and clearances finite (a clearance down to an interference
+    as deep as contact.max_penetration)."""
+    import math
+
+    from ..errors import ParameterError
+
+    smax = p.normalisation.speed_max
+
+    def bad(flag: str, value, accepted: str):
+        raise ParameterError(f"--{flag}: {value!r} out of range; accepted {accepted}")
+
+    for name in ("speed", "speed_min", "speed_max"):
+        v = getattr(ns, name, None)
+        if v is not None and not (math.isfinite(v) and 0.0 <= v <= smax):
+            bad(name.replace("_", "-"), v, f"[0, {smax:g}] (normalised speed; the model's validity ends at "
+                f"normalisation.speed_max = {smax:g} of the parameter file)")
+    lo, hi = getattr(ns, "speed_min", None), getattr(ns, "speed_max", None)
+    if lo is not None and hi is not None and not lo < hi:
+        bad("speed-min", lo, f"below --speed-max = {hi!r}")
+    for name in ("n_speeds", "n_g0"):
+        v = getattr(ns, name, None)
+        if v is not None and v < 2:
+            bad(name.replace("_", "-"), v, "[2, inf) (a grid needs two points)")
+    v = getattr(ns, "t_end", None)
+    if v is not None and not (math.isfinite(v) and v > 0):
+        bad("t-end", v, "(0, inf) s")
+    v = getattr(ns, "g0", None)
+    if v is not None and not (math.isfinite(v) and -p.contact.max_penetration <= v <= 0.1):
+        bad("g0", v, f"[{-p.contact.max_penetration:g}, 0.1] m (down to an interference as deep as "
+            "contact.max_penetration)")
+    v = getattr(ns, "formulation", None)
+    if v is not None and v not in ("2D", "3D"):
+        bad("formulation", v, "2D or 3D")
+
+
 def _model(ns: argparse.Namespace):
     from ..structure.model import build_model
 
@@ -156,13 +195,16 @@ def cmd_stability(ns: argparse.Namespace) -> dict:
 
 
 @command("transient", "2D and 3D central-difference transients (paper Fig. 12)")
-@arg("--speed", type=float, default=None, help="normalised spin speed (default: picked from the stability maps)")
+@arg("--speed", type=float, default=None, help="normalised spin speed (default: picked from this configuration's "
+     "stability maps: 2D unstable, 3D stable)")
 @arg("--g0", type=float, default=None, help="nominal clearance [m] (default: picked with the speed)")
 @arg("--t-end", type=float, default=20.0, help="simulated time [s] (imbalance ramped over the first second)")
+@arg("--maps", default=None, help="a stability study's folder (rotorub stability --out DIR) to pick the point from; "
+     "default: the quick maps are computed")
 def cmd_transient(ns: argparse.Namespace) -> dict:
     from .studies import run_transient_study
 
-    return run_transient_study(_model(ns), ns.out, ns.speed, ns.g0, t_end=ns.t_end)
+    return run_transient_study(_model(ns), ns.out, ns.speed, ns.g0, t_end=ns.t_end, stab_dir=ns.maps)
 
 
 @command("detect", "contact detection maps over (speed, g0): 2D, 3D, degraded 3D, theta and chord sweeps")
@@ -273,6 +315,7 @@ def main(argv: list[str] | None = None) -> int:
     ns = ap.parse_args(argv)
     fn = COMMANDS[ns.command][2]
     try:
+        check_arguments(ns, load_parameters(ns.params))
         result = fn(ns)
     except RotorubError as exc:
         print(f"rotorub {ns.command}: error: {exc}", file=sys.stderr)
