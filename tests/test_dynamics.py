@@ -203,7 +203,8 @@ def test_transient_divergence_depth_is_the_parameter_files():
 
     runs = {}
     for depth in (2e-5, None):
-        p = reference_parameters() if depth is None else reference_parameters().replace(contact={"max_penetration": depth})
+        p = reference_parameters()
+        p = p if depth is None else p.replace(contact={"max_penetration": depth})
         m = build_model(p)
         c = make_contact(m, "2D", g0=-5e-5)
         runs[depth] = run_transient(m, c, 0.5 * p.normalisation.omega_ref, t_end=0.01, t_ramp=0.0, me=0.0)

@@ -243,7 +243,10 @@ def run_modes(model: Model, speed: float, K_extra: np.ndarray | None = None) -> 
         m = max(w, key=w.get)
         harm[i] = m
         fixed[i] = abs(lam[i].imag + m * omega) / (2 * np.pi)
-    zeta = -lam.real / np.maximum(np.abs(lam), 1e-300)
+    # The damping ratio belongs to the motion an observer sees: a mode whose rotating-frame
+    # frequency is near zero (the critical mode near its critical speed) would otherwise read
+    # zeta ~ 1 from |lambda| ~ |Re lambda|, while in the fixed frame it whirls at ~Omega.
+    zeta = -lam.real / np.maximum(np.hypot(lam.real, 2 * np.pi * fixed), 1e-300)
     return ModesResult(speed, lam, fixed, harm, zeta)
 
 
