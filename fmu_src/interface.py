@@ -51,6 +51,9 @@ UNITS: dict[str, tuple[dict[str, int], dict[str, float]]] = {
 }
 
 STATUS_OK, STATUS_DIVERGED, STATUS_BAD_INPUT, STATUS_UNSTABLE = 0, 1, 2, 3
+# the most substeps one communication step takes (native: fmu_model.h MODEL_MAX_SUBSTEPS); a longer step is
+# refused with fmi2Error naming the longest allowed, not minutes to hours inside a call no master can cancel
+MAX_SUBSTEPS = 10_000_000
 STATUS_TEXT = ("0 = ok; 1 = diverged (transient: a penetration beyond max_penetration or a non-finite state) or, in "
                "quasi_static mode, no balanced solution; 2 = bad input or configuration (cause in 'message' and the "
                "log); 3 = quasi_static: the balanced solution is unstable (max_real_eig > 0)")

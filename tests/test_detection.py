@@ -185,6 +185,6 @@ def test_cli_detect(tmp_path, capsys):
 def test_cli_detect_bad_args(tmp_path, capsys):
     assert main(["detect", "--out", str(tmp_path), "--n-g0", "1"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "n_g0" in err[0]
+    assert len(err) == 1 and "--n-g0" in err[0] and "[2, inf)" in err[0]
     assert main(["detect", "--out", str(tmp_path), "--g0-max-mm", "-2"]) == 2
     assert "g0_max" in capsys.readouterr().err

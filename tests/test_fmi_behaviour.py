@@ -647,3 +647,150 @@ def test_errors_reach_the_logger_with_logging_off(inst, flavour):
     if flavour == "native":
         assert "Omega" in inst.logged()
     assert "Omega" in inst.message()
+
+
+# --------------------------------------------------------------- found by benchmarks/fuzz_fmi.py (issue 17)
+def _blade_outputs(i: Inst) -> list[float]:
+    return i.f.getReal([i.vr[f"blade[{j}].{q}"] for j in range(1, 11) for q in ("F_N", "gap_LE", "gap_TE")])
+
+
+@pytest.mark.parametrize("h", [1e12, 1e6])
+def test_a_step_too_long_is_refused_at_once_with_the_longest_allowed(inst, flavour, h):
+    """A communication step that needs more than MAX_SUBSTEPS substeps: 1e12 s overflowed the native int
+    count into one unstable substep (fmi2OK, gap_min = -3e10 m); 1e6 s took hours in one call no master can
+    cancel. Refused at once, the longest step named, the state left as it was."""
+    import time
+
+    from fmu_src.interface import MAX_SUBSTEPS
+
+    ref = Inst(inst.f.unzipDirectory, "ref")
+    try:
+        for i in (inst, ref):
+            assert i.init(**START) == OK
+            for _ in range(3):
+                assert i.step() == OK
+        t0 = time.perf_counter()
+        s = inst.step(h)
+        assert time.perf_counter() - t0 < 1.0
+        assert s == (ERROR if flavour == "native" else DISCARD)  # pythonfmu: DOCUMENTED_LIMIT
+        assert f"at most {MAX_SUBSTEPS} are taken in one step" in inst.said() and "h <= " in inst.said()
+        assert not _terminated(inst) or flavour != "native"
+        assert inst.step() == OK and ref.step() == OK
+        assert _blade_outputs(inst) == _blade_outputs(ref)
+    finally:
+        ref.free()
+
+
+def test_native_substep_cap_is_the_interfaces():
+    from pathlib import Path
+
+    from fmu_src.interface import MAX_SUBSTEPS
+
+    header = (Path(__file__).parents[1] / "fmu_src" / "native" / "fmu_model.h").read_text()
+    assert f"#define MODEL_MAX_SUBSTEPS {MAX_SUBSTEPS}" in header
+
+
+def test_the_step_that_crosses_the_limit_is_the_discarded_one(inst, flavour):
+    """A step whose last substep ends beyond max_penetration returned fmi2OK (the kernel checked each substep's
+    start only) and the next step was discarded: every fmi2OK step must end within the limit."""
+    assert inst.init(**{**START, "max_penetration": 1e-5, "g0": -5e-7}) == OK
+    for _ in range(200):
+        s = inst.step()
+        if s != OK:
+            break
+        assert inst.real("gap_min") > -1e-5, "an fmi2OK step ended beyond max_penetration"
+    assert s == DISCARD and inst.real("gap_min") <= -1e-5 and inst.integer("status") == 1
+    assert _terminated(inst)
+
+
+def test_a_refused_tiny_step_leaves_the_instance_as_it_was(inst, flavour):
+    """h = 1e-300 makes the central-difference matrix singular: refused, and the next step equals the same step
+    without the refused one bit for bit (the two-step scheme used to be restarted before the refusal)."""
+    ref = Inst(inst.f.unzipDirectory, "ref")
+    try:
+        for i in (inst, ref):
+            assert i.init(**START) == OK
+            for _ in range(3):
+                assert i.step() == OK
+        s = inst.step(1e-300)
+        assert s != OK and "singular" in inst.said()
+        assert inst.step() == OK and ref.step() == OK
+        assert _blade_outputs(inst) == _blade_outputs(ref)
+    finally:
+        ref.free()
+
+
+def test_calls_the_standard_does_not_allow_are_refused(unzipped, flavour):
+    """FMI 2.0 co-simulation's calling sequence: no fmi2Get* before fmi2EnterInitializationMode, no
+    fmi2Terminate in initialization mode, no input after a discarded step (stepFailed: roll back first).
+    pythonfmu: an exception there would be fmi2Fatal, so the refusal is logged at the call with fmi2OK
+    (DOCUMENTED_LIMIT), and fmi2Terminate leaves it in initialization mode."""
+    refused = ERROR if flavour == "native" else OK
+    i = Inst(unzipped)
+    try:
+        s = i.call("fmi2GetReal", (fmi2ValueReference * 1)(i.vr["gap_min"]), 1, (fmi2Real * 1)())
+        told = i.logged() if flavour == "native" else i.message()  # native: no fmi2GetString yet either
+        assert s == refused and "values are read from fmi2EnterInitializationMode on" in told
+        i.call("fmi2SetupExperiment", 0, 0.0, 0.0, 0, 0.0)
+        assert i.call("fmi2EnterInitializationMode") == OK
+        assert i.call("fmi2Terminate") == refused and "fmi2Reset or fmi2FreeInstance" in i.said()
+        assert i.set_real(**DIVERGES) == OK and i.call("fmi2ExitInitializationMode") == OK
+        while (s := i.step()) == OK:
+            pass
+        assert s == DISCARD
+        n = len(i.messages)
+        s = i.set_real(Omega=100.0)
+        assert s == (ERROR if flavour == "native" else OK)  # pythonfmu: logged at the call (DOCUMENTED_LIMIT)
+        assert "roll back with fmi2SetFMUstate first" in (i.logged(n) if flavour == "native" else i.message())
+        assert i.call("fmi2Terminate") == OK
+    finally:
+        i.free()
+
+
+def test_a_wrong_guid_is_named_in_the_log(unzipped, flavour):
+    """fmi2Instantiate's refusal of a foreign GUID reached fmpy's (non-formatting) logger as a raw format
+    ("GUID '%s' is not this FMU's (%s)"): the message must carry both GUIDs."""
+    if flavour != "native":
+        pytest.skip("pythonfmu 0.7 does not check the GUID")
+    md = read_model_description(unzipped)
+    got = []
+
+    def logger(_env, _name, status, _cat, message):
+        got.append(message.decode("utf-8", "replace"))
+
+    cb = fmi2CallbackFunctions()
+    cb.logger = fmi2CallbackLoggerTYPE(logger)
+    cb.allocateMemory = fmpy.fmi2.fmi2CallbackAllocateMemoryTYPE(fmpy.calloc)
+    cb.freeMemory = fmpy.fmi2.fmi2CallbackFreeMemoryTYPE(fmpy.free)
+    f = FMU2Slave(guid="{not-this-one}", unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
+                  instanceName="x")
+    with pytest.raises(Exception, match="instantiate"):
+        f.instantiate(callbacks=cb)
+    text = " ".join(got)
+    assert "{not-this-one}" in text and md.guid in text and "%s" not in text, text
+
+
+def test_a_state_of_another_native_fmu_is_refused(unzipped, flavour, tmp_path):
+    """In-memory FMU states carried no identity: every FMU on the wrapper shares its magic number, and a state of
+    the LP spool FMU given to the contact FMU was refused only because the sizes differed, after the wrapper had
+    configured a model from the spool's values. It must be refused as another FMU's, nothing changed."""
+    if flavour != "native":
+        pytest.skip("the pythonfmu flavour's states are Python objects of its own class")
+    from fmu_src.engine.spool import build_native_spool_fmu
+
+    spool_dir = extract(str(build_native_spool_fmu(tmp_path, platforms=("linux64",))), str(tmp_path / "spool"))
+    sp, c = Inst(spool_dir, "spool"), Inst(unzipped, "contact")
+    try:
+        assert sp.init() == OK and c.init(**START) == OK
+        assert sp.step() == OK and c.step() == OK
+        foreign = ctypes.c_void_p()
+        assert sp.call("fmi2GetFMUstate", ctypes.byref(foreign)) == OK
+        before = _blade_outputs(c)
+        n = len(c.messages)
+        assert c.call("fmi2SetFMUstate", foreign) == ERROR
+        assert "another FMU's or build's" in c.logged(n)
+        assert _blade_outputs(c) == before and c.step() == OK
+        assert sp.call("fmi2FreeFMUstate", ctypes.byref(foreign)) == OK
+    finally:
+        sp.free()
+        c.free()

@@ -28,6 +28,7 @@ DESCRIPTION = (
     "torque of the blade-tip/casing contact (RotorCasingContact.fmu) slows it down."
 )
 STATUS_OK, STATUS_STOPPED, STATUS_ERROR = 0, 1, 2
+MAX_SUBSTEPS = 10_000_000  # per communication step, as the contact FMU's (fmu_model.h MODEL_MAX_SUBSTEPS)
 
 # reference low-pressure spool of the rotorub fan (reference.toml): polar inertia of the fan hub
 # (15.7) + LP turbine (9.2) + ten 5.8 kg blades from r = 0.4 to 1.0 m (10 x 3.02) + hollow shaft (0.44)

@@ -274,8 +274,16 @@ static int substeps(model_runtime *m, double w, double h, char *msg, size_t len)
         m->have_lim = 1;
     }
     cap = m->dt_max < 0.5 * m->lim ? m->dt_max : 0.5 * m->lim;
-    m->plan_n = (int)rr_ceil(h / cap * (1.0 - 1e-9));
-    if (m->plan_n < 1) m->plan_n = 1;
+    {
+        double nd = rr_ceil(h / cap * (1.0 - 1e-9));
+        if (!(nd <= MODEL_MAX_SUBSTEPS)) {
+            snprintf(msg, len, "communication step h = %.17g s needs %.3g substeps of at most %.17g s (dt_max, or half "
+                     "the central-difference limit at %g rad/s); at most %d are taken in one step (h <= %.17g s)",
+                     h, nd, cap, band, MODEL_MAX_SUBSTEPS, MODEL_MAX_SUBSTEPS * cap);
+            return -1;
+        }
+        m->plan_n = nd < 1.0 ? 1 : (int)nd;
+    }
     m->plan_h = h;
     m->plan_band = band;
     m->have_plan = 1;
@@ -296,17 +304,11 @@ static fmi2Status transient_step(model_runtime *m, model_values *v, double w, do
     ns = substeps(m, w, h, msg, len);
     if (ns < 1) return fmi2Error;
     dt = h / ns;
-    if (dt != m->st.dt) { /* restart the two-step scheme at the same velocity */
-        for (i = 0; i < n; ++i) {
-            double vel = (m->q[i] - m->qp[i]) / m->st.dt;
-            if (m->st.dt == 0.0) vel = 0.0; /* at rest before the first step */
-            m->qp[i] = m->q[i] - dt * vel;
-        }
-        m->st.dt = dt;
-    }
+    /* the matrices first: a step refused here leaves the state as it was (the two-step scheme untouched) */
     if (!m->have_mats || m->mats_omega != w || m->mats_dt != dt) {
         if (rr_cd_build(n, d->M, d->D, d->K, d->G1, d->C1, d->N2, d->S2, NULL, w, 0.0, dt, m->Ainv, m->K2, m->Cm1,
                         m->mwork, m->piv) != 0) {
+            m->have_mats = 0; /* the buffers hold a failed build */
             snprintf(msg, len, "the central-difference matrix is singular at %g rad/s, dt = %g s", w, dt);
             return fmi2Error;
         }
@@ -316,6 +318,14 @@ static fmi2Status transient_step(model_runtime *m, model_values *v, double w, do
         m->mats_dt = dt;
     }
     (void)nn;
+    if (dt != m->st.dt) { /* restart the two-step scheme at the same velocity */
+        for (i = 0; i < n; ++i) {
+            double vel = (m->q[i] - m->qp[i]) / m->st.dt;
+            if (m->st.dt == 0.0) vel = 0.0; /* at rest before the first step */
+            m->qp[i] = m->q[i] - dt * vel;
+        }
+        m->st.dt = dt;
+    }
     m->job.n_steps = ns;
     m->job.omega = w;
     m->job.me = me;
@@ -329,7 +339,7 @@ static fmi2Status transient_step(model_runtime *m, model_values *v, double w, do
     finish_outputs(v, 0.0);
     v->r[VR_DT_INTERNAL] = dt;
     v->i[VR_N_SUBSTEPS] = done;
-    if (done < ns) {
+    if (done < ns || m->st.diverged) {
         snprintf(msg, len, "the run diverged at t = %.6g s (internal time): a blade penetrated the casing deeper "
                  "than max_penetration = %g mm (or the state stopped being finite); the outputs are those of that "
                  "state", m->st.t, m->max_pen * 1e3);

@@ -57,6 +57,7 @@ typedef struct {
 
 typedef struct {
     unsigned magic;
+    const model_info *info; /* &MODEL_INFO of the binary that made it: another FMU's (or build's) is refused */
     const inst_t *owner;
     phase_t phase;
     double time, last_good;
@@ -70,6 +71,9 @@ typedef struct {
 } snapshot_t;
 
 #define N_VARS ((size_t)MODEL_INFO.n_vars)
+/* a snapshot this binary made: every FMU built on this wrapper shares STATE_MAGIC, and the model state's
+ * size alone does not tell two builds of one model apart */
+#define IS_OURS(p) ((p) && (p)->magic == STATE_MAGIC && (p)->info == &MODEL_INFO)
 #define VAR(vr) (&MODEL_INFO.vars[vr])
 
 /* the shortest decimal that reads back as x (%.17g writes 640.8 as 640.79999999999995) */
@@ -85,6 +89,21 @@ static const char *num(double x, char *buf, size_t len)
 
 /* ------------------------------------------------------------------ logging and errors */
 
+/* Hand a formatted message to the host's logger. The message is passed as the format: loggers that do not
+ * format (fmpy's) see it as it is, and a '%' is doubled for those that do. */
+static void emit(const fmi2CallbackFunctions *cb, const char *name, fmi2Status status, const char *category,
+                 const char *text)
+{
+    char fmt_buf[2 * MSG_LEN];
+    size_t k, j = 0;
+    for (k = 0; text[k] && j + 2 < sizeof fmt_buf; ++k) {
+        fmt_buf[j++] = text[k];
+        if (text[k] == '%') fmt_buf[j++] = '%';
+    }
+    fmt_buf[j] = '\0';
+    cb->logger(cb->componentEnvironment, name, status, category, fmt_buf);
+}
+
 static void logv(inst_t *c, fmi2Status status, const char *category, const char *fmt, va_list ap)
 {
     char buf[MSG_LEN];
@@ -93,18 +112,7 @@ static void logv(inst_t *c, fmi2Status status, const char *category, const char 
         memcpy(c->message, buf, sizeof buf);
         c->message[MSG_LEN - 1] = '\0';
     }
-    if (c->cb.logger && (status >= fmi2Warning || c->logging)) {
-        /* the message is the format: loggers that do not format (fmpy's) see it as it is, and a
-         * '%' is doubled for those that do */
-        char fmt_buf[2 * MSG_LEN];
-        size_t k, j = 0;
-        for (k = 0; buf[k] && j + 2 < sizeof fmt_buf; ++k) {
-            fmt_buf[j++] = buf[k];
-            if (buf[k] == '%') fmt_buf[j++] = '%';
-        }
-        fmt_buf[j] = '\0';
-        c->cb.logger(c->cb.componentEnvironment, c->name, status, category, fmt_buf);
-    }
+    if (c->cb.logger && (status >= fmi2Warning || c->logging)) emit(&c->cb, c->name, status, category, buf);
 }
 
 /* A refused call: logged (status fmi2Error or fmi2Discard), its cause in 'message', and for an
@@ -136,6 +144,16 @@ static void debug(inst_t *c, const char *fmt, ...)
     } while (0)
 
 /* ------------------------------------------------------------------ values */
+
+/* FMI 2.0 co-simulation: values are read from fmi2EnterInitializationMode on (the start values before that are
+ * the model description's) */
+static fmi2Status check_readable(inst_t *c, const char *fn)
+{
+    if (c->phase == PH_INSTANTIATED)
+        return fail(c, fmi2Error, "%s: the instance is instantiated: values are read from "
+                    "fmi2EnterInitializationMode on (the start values are in modelDescription.xml)", fn);
+    return fmi2OK;
+}
 
 /* the only String a model has is its 'message' output (the build refuses any other) */
 static void set_starts(inst_t *c)
@@ -175,6 +193,9 @@ static fmi2Status check_settable(inst_t *c, const char *fn, fmi2ValueReference v
         return fail(c, fmi2Error, "%s: %s is an output and cannot be set", fn, v->name);
     if (c->phase == PH_TERMINATED)
         return fail(c, fmi2Error, "%s: %s: the instance is terminated (fmi2Reset or fmi2FreeInstance)", fn, v->name);
+    if (c->stopped) /* FMI 2.0: no inputs in stepFailed (after fmi2Discard): the master rolls back or ends */
+        return fail(c, fmi2Error, "%s: %s: the FMU ended this simulation (fmi2Terminated is true): %s; roll back with "
+                    "fmi2SetFMUstate first, or fmi2Terminate / fmi2Reset", fn, v->name, c->stop_reason);
     if (v->variability == VV_FIXED && c->phase == PH_STEP)
         return fail(c, fmi2Error, "%s: %s is a fixed parameter: it cannot change after initialisation (fmi2Reset "
                     "first)", fn, v->name);
@@ -265,9 +286,10 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         return NULL;
     }
     if (!fmuGUID || strcmp(fmuGUID, MODEL_INFO.guid) != 0) {
-        functions->logger(functions->componentEnvironment, instanceName, fmi2Error, "logStatusError",
-                          "fmi2Instantiate: GUID '%s' is not this FMU's (%s): modelDescription.xml and the binary "
-                          "come from different builds", fmuGUID ? fmuGUID : "(null)", MODEL_INFO.guid);
+        char buf[MSG_LEN];
+        snprintf(buf, sizeof buf, "fmi2Instantiate: GUID '%s' is not this FMU's (%s): modelDescription.xml and the "
+                 "binary come from different builds", fmuGUID ? fmuGUID : "(null)", MODEL_INFO.guid);
+        emit(functions, instanceName, fmi2Error, "logStatusError", buf);
         return NULL;
     }
     c = (inst_t *)calloc(1, sizeof *c);
@@ -365,8 +387,9 @@ fmi2Status fmi2Terminate(fmi2Component comp)
 {
     inst_t *c = INST(comp);
     CHECK_INSTANCE(comp, "fmi2Terminate");
-    if (c->phase != PH_STEP && c->phase != PH_INITIALIZATION)
-        return fail(c, fmi2Error, "fmi2Terminate: the instance is in %s", PHASE_NAME[c->phase]);
+    if (c->phase != PH_STEP) /* FMI 2.0 co-simulation: after initialisation only (fmi2Reset ends the others) */
+        return fail(c, fmi2Error, "fmi2Terminate: the instance is in %s (a simulation ends with fmi2Terminate "
+                    "once it is initialised; fmi2Reset or fmi2FreeInstance end it in any state)", PHASE_NAME[c->phase]);
     c->phase = PH_TERMINATED;
     return fmi2OK;
 }
@@ -390,6 +413,7 @@ fmi2Status fmi2GetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t
     size_t k;
     fmi2Status s;
     CHECK_INSTANCE(comp, "fmi2GetReal");
+    if ((s = check_readable(c, "fmi2GetReal")) != fmi2OK) return s;
     if (nvr && (!vr || !value)) return fail(c, fmi2Error, "fmi2GetReal: NULL array");
     for (k = 0; k < nvr; ++k)
         if ((s = check_vr(c, "fmi2GetReal", vr[k], 1, 0, 0)) != fmi2OK) return s;
@@ -404,6 +428,7 @@ fmi2Status fmi2GetInteger(fmi2Component comp, const fmi2ValueReference vr[], siz
     size_t k;
     fmi2Status s;
     CHECK_INSTANCE(comp, "fmi2GetInteger");
+    if ((s = check_readable(c, "fmi2GetInteger")) != fmi2OK) return s;
     if (nvr && (!vr || !value)) return fail(c, fmi2Error, "fmi2GetInteger: NULL array");
     for (k = 0; k < nvr; ++k)
         if ((s = check_vr(c, "fmi2GetInteger", vr[k], 0, 1, 0)) != fmi2OK) return s;
@@ -430,6 +455,7 @@ fmi2Status fmi2GetString(fmi2Component comp, const fmi2ValueReference vr[], size
     size_t k;
     fmi2Status s;
     CHECK_INSTANCE(comp, "fmi2GetString");
+    if ((s = check_readable(c, "fmi2GetString")) != fmi2OK) return s;
     if (nvr && (!vr || !value)) return fail(c, fmi2Error, "fmi2GetString: NULL array");
     for (k = 0; k < nvr; ++k)
         if ((s = check_vr(c, "fmi2GetString", vr[k], 0, 0, 1)) != fmi2OK) return s;
@@ -633,7 +659,7 @@ fmi2Status fmi2GetFMUstate(fmi2Component comp, fmi2FMUstate *state)
     CHECK_INSTANCE(comp, "fmi2GetFMUstate");
     if (!state) return fail(c, fmi2Error, "fmi2GetFMUstate: NULL pointer");
     p = (snapshot_t *)*state;
-    if (p && p->magic != STATE_MAGIC) return fail(c, fmi2Error, "fmi2GetFMUstate: *FMUstate is not a state of this FMU");
+    if (p && !IS_OURS(p)) return fail(c, fmi2Error, "fmi2GetFMUstate: *FMUstate is not a state of this FMU");
     if (!p) {
         p = (snapshot_t *)calloc(1, sizeof *p);
         if (!p) return fail(c, fmi2Error, "fmi2GetFMUstate: out of memory");
@@ -645,6 +671,7 @@ fmi2Status fmi2GetFMUstate(fmi2Component comp, fmi2FMUstate *state)
         }
     }
     p->magic = STATE_MAGIC;
+    p->info = &MODEL_INFO;
     p->owner = c;
     p->phase = c->phase;
     p->time = c->time;
@@ -691,7 +718,7 @@ static fmi2Status restore(inst_t *c, const snapshot_t *p, const char *fn)
     char msg[MSG_LEN];
     model_runtime *m = NULL;
     int fresh = 0;
-    if (!p || p->magic != STATE_MAGIC) return fail(c, fmi2Error, "%s: not a state of this FMU", fn);
+    if (!IS_OURS(p)) return fail(c, fmi2Error, "%s: not a state of this FMU (another FMU's or build's)", fn);
     if (p->phase > PH_TERMINATED || (p->phase == PH_STEP && !p->n_model))
         return fail(c, fmi2Error, "%s: corrupt state (phase)", fn);
     if (p->n_model) {
@@ -738,7 +765,7 @@ fmi2Status fmi2FreeFMUstate(fmi2Component comp, fmi2FMUstate *state)
 {
     CHECK_INSTANCE(comp, "fmi2FreeFMUstate");
     if (!state || !*state) return fmi2OK;
-    if (((snapshot_t *)*state)->magic != STATE_MAGIC)
+    if (!IS_OURS((snapshot_t *)*state))
         return fail(INST(comp), fmi2Error, "fmi2FreeFMUstate: not a state of this FMU");
     free_snapshot((snapshot_t *)*state);
     *state = NULL;
@@ -757,7 +784,7 @@ static size_t serialized_size_of(size_t n_model)
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component comp, fmi2FMUstate state, size_t *size)
 {
     CHECK_INSTANCE(comp, "fmi2SerializedFMUstateSize");
-    if (!state || ((snapshot_t *)state)->magic != STATE_MAGIC || !size)
+    if (!IS_OURS((snapshot_t *)state) || !size)
         return fail(INST(comp), fmi2Error, "fmi2SerializedFMUstateSize: not a state of this FMU");
     *size = serialized_size_of(((const snapshot_t *)state)->n_model);
     return fmi2OK;
@@ -770,7 +797,7 @@ fmi2Status fmi2SerializeFMUstate(fmi2Component comp, fmi2FMUstate state, fmi2Byt
     unsigned long long u;
     char guid[GUID_BYTES];
     CHECK_INSTANCE(comp, "fmi2SerializeFMUstate");
-    if (!p || p->magic != STATE_MAGIC) return fail(INST(comp), fmi2Error, "fmi2SerializeFMUstate: not a state of this FMU");
+    if (!IS_OURS(p)) return fail(INST(comp), fmi2Error, "fmi2SerializeFMUstate: not a state of this FMU");
     if (!bytes || size != serialized_size_of(p->n_model))
         return fail(INST(comp), fmi2Error, "fmi2SerializeFMUstate: the buffer has %zu bytes, the state needs %zu", size,
                     serialized_size_of(p->n_model));
@@ -832,6 +859,7 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component comp, const fmi2Byte bytes[], s
         return fail(c, fmi2Error, "fmi2DeSerializeFMUstate: out of memory");
     }
     p->magic = STATE_MAGIC;
+    p->info = &MODEL_INFO;
     p->owner = c;
     p->phase = (phase_t)phase;
     p->n_model = (size_t)nm;

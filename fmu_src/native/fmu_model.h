@@ -45,6 +45,11 @@ typedef struct {
 
 extern const model_info MODEL_INFO;
 
+/* The most substeps one fmi2DoStep may take (fmu_src/interface.py MAX_SUBSTEPS): a longer communication
+ * step is refused with fmi2Error and the longest step allowed, instead of minutes to hours inside one call
+ * that no master can cancel (and an int that overflows). */
+#define MODEL_MAX_SUBSTEPS 10000000
+
 /* the status output's codes every model shares (a model may add its own above these) */
 enum { STATUS_OK = 0, STATUS_DIVERGED = 1, STATUS_BAD_INPUT = 2 };
 

@@ -102,9 +102,16 @@ static double rhs(const model_runtime *m, double s, double e, double tau)
 fmi2Status model_step(model_runtime *m, model_values *v, double t, double h, char *msg, size_t len)
 {
     double tau = v->r[VR_TAU], e = m->e, ds, ws, wsd, w;
-    int n = (int)rr_ceil(h / m->dt_max * (1.0 - 1e-12)), i;
+    double nd = rr_ceil(h / m->dt_max * (1.0 - 1e-12));
+    int n, i;
     m->advanced = 0.0;
-    if (n < 1) n = 1;
+    if (!(nd <= MODEL_MAX_SUBSTEPS)) {
+        snprintf(msg, len, "communication step h = %.17g s needs %.3g substeps of at most dt_max = %.17g s; at most "
+                 "%d are taken in one step (h <= %.17g s); step refused, state unchanged", h, nd, m->dt_max,
+                 MODEL_MAX_SUBSTEPS, MODEL_MAX_SUBSTEPS * m->dt_max);
+        return fmi2Error;
+    }
+    n = nd < 1.0 ? 1 : (int)nd;
     ds = h / n;
     m->t = t;
     for (i = 0; i < n; ++i) {

@@ -44,6 +44,10 @@ _LIB_MODULES = ("errors", "results", "kernel.compiler", "kernel", "structure.par
                 "analyses.linear", "analyses.transient", "analyses.static")
 
 
+class _StepRefused(Exception):
+    """A communication step this FMU refuses (fmi2Error), the instance left as it was."""
+
+
 def _load(resources: Path) -> tuple[dict, object, object]:
     """(manifest, namespace of the bundled library's modules, the interface module)."""
     manifest = json.loads((resources / MANIFEST).read_text())
@@ -160,6 +164,10 @@ class RotorCasingContact(Fmi2Slave):
             return self._refuse(f"{v.name} is an output and cannot be set (value ignored)")
         if self._phase == "terminated":
             return self._refuse(f"{v.name}: the instance is terminated (fmi2Reset or free it)")
+        if self._stopped is not None:
+            return self._refuse(f"{v.name}: the FMU ended this simulation (fmi2Terminated is true): "
+                                f"{self._stopped[1]}; roll back with fmi2SetFMUstate first, or fmi2Terminate / "
+                                "fmi2Reset")
         if self._phase == "step" and v.variability == "fixed":
             return self._refuse(f"{v.name} is a fixed parameter: it cannot change after initialisation (fmi2Reset "
                                 "first); value ignored")
@@ -183,7 +191,17 @@ class RotorCasingContact(Fmi2Slave):
             self._iv[i] = value
 
     # fast paths for the per-step traffic (same semantics as the registered getters and setters)
+    def _readable(self, fn: str) -> None:
+        """FMI 2.0 co-simulation: values are read from fmi2EnterInitializationMode on. The native FMU returns
+        fmi2Error; a getter of pythonfmu 0.7 that raises makes fmi2Fatal, so this one logs the error and
+        returns the start values (fmu_src/FMU.md, 'What pythonfmu cannot honour')."""
+        if self._phase == "instantiated":
+            self._log_error(f"{fn}: the instance is instantiated: values are read from fmi2EnterInitializationMode "
+                            "on (the start values are in modelDescription.xml)")
+
     def get_real(self, vrs):
+        if self._phase == "instantiated":
+            self._readable("fmi2GetReal")
         memo_vrs, idx = self._get_memo
         if vrs != memo_vrs:  # a master reads the same list every step: check and convert it once
             idx = np.asarray(vrs, dtype=np.intp)
@@ -195,6 +213,7 @@ class RotorCasingContact(Fmi2Slave):
         return self._rv.take(idx).tolist()
 
     def get_integer(self, vrs):
+        self._readable("fmi2GetInteger")
         idx = np.asarray(vrs, dtype=np.intp)
         if not self._is_int[idx].all():
             raise TypeError(f"get_integer: value reference(s) {idx[~self._is_int[idx]].tolist()} are not Integer")
@@ -205,7 +224,8 @@ class RotorCasingContact(Fmi2Slave):
     def set_real(self, vrs, values):
         rv, inputs = self._rv, self._real_inputs
         for vr, v in zip(vrs, values):
-            if (vr in inputs and self._phase != "terminated" and self._vars[vr].min <= v <= self._vars[vr].max
+            if (vr in inputs and self._phase != "terminated" and self._stopped is None
+                    and self._vars[vr].min <= v <= self._vars[vr].max
                     and (vr != self._i_g0 or self._sim is None or v >= -self._sim["config"]["max_penetration"])):
                 if rv[vr] != v:  # the per-step traffic: Omega, imbalance, g0 (tunable), in range
                     self._stale = True
@@ -250,6 +270,10 @@ class RotorCasingContact(Fmi2Slave):
             self._configuration_error(self._message(exc))
 
     def terminate(self):
+        if self._phase != "step":  # logged, not raised: pythonfmu would make it fmi2Fatal
+            self._log_error(f"fmi2Terminate: the instance is in {self._phase} mode (a simulation ends with "
+                            "fmi2Terminate once it is initialised; fmi2Reset or fmi2FreeInstance end it in any state)")
+            return
         self._phase = "terminated"
 
     def do_step(self, current_time, step_size):
@@ -413,7 +437,13 @@ class RotorCasingContact(Fmi2Slave):
                 lim = self._lib.transient.critical_time_step(sim["model"], sim["contact"], float(band))
                 sim["limit"] = (band, lim)
             cap = min(sim["config"]["dt_max"], 0.5 * lim)
-            sim["plan"] = (h, band, max(1, math.ceil(h / cap * (1 - 1e-9))))
+            n = math.ceil(h / cap * (1 - 1e-9))
+            if not n <= self._if.MAX_SUBSTEPS:
+                top = self._if.MAX_SUBSTEPS * cap
+                raise _StepRefused(f"communication step h = {h!r} s needs {float(n):.3g} substeps of at most {cap!r} s "
+                                   f"(dt_max, or half the central-difference limit at {band:g} rad/s); at most "
+                                   f"{self._if.MAX_SUBSTEPS} are taken in one step (h <= {top!r} s)")
+            sim["plan"] = (h, band, max(1, n))
         return sim["plan"][2]
 
     def _transient(self, omega: float, me: float, h: float) -> bool:
@@ -421,18 +451,21 @@ class RotorCasingContact(Fmi2Slave):
         if cd.diverged:
             self._report(self._if.STATUS_DIVERGED, f"the run diverged at t = {cd.t:.6g} s (internal time)")
             return False
-        n = self._substeps(omega, h)
-        dt = h / n
-        if dt != cd.dt:  # restart the two-step scheme at the same velocity
-            v = cd.velocity()
-            cd.dt = dt
-            cd.q_prev[:] = cd.q - dt * v
+        try:
+            n = self._substeps(omega, h)
+            dt = h / n
+            if dt != cd.dt:  # restart the two-step scheme at the same velocity (nothing changes if refused)
+                cd.restart(dt, omega)
+        except (_StepRefused, self._lib.errors.ParameterError) as exc:
+            self._report(self._if.STATUS_BAD_INPUT, str(exc) if isinstance(exc, _StepRefused) else
+                         f"the central-difference matrix is singular at {omega:g} rad/s, dt = {h / n:g} s")
+            return False
         done, _ = cd.advance(n, omega, me)  # the kernel writes the outputs into self._rv (bind_outputs)
         rv, iv = self._rv, self._iv
         iv[self._i_nc] = rv[self._i_nc]
         rv[self._i_dt] = dt
         iv[self._i_nsub] = done
-        if done < n:
+        if done < n or cd.diverged:
             self._report(self._if.STATUS_DIVERGED, f"the run diverged at t = {cd.t:.6g} s (internal time): a blade "
                          f"penetrated the casing deeper than max_penetration = {cd.max_penetration * 1e3:g} mm (or "
                          "the state stopped being finite); the outputs are those of that state")

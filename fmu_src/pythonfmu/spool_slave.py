@@ -299,6 +299,13 @@ class LPSpool(Fmi2Slave):
             self._report(STATUS_ERROR, f"currentCommunicationPoint = {t!r} does not match the FMU's time {self._t!r} "
                          "(steps must follow each other; to go back, use fmi2SetFMUstate)")
             return False
+        n = math.ceil(h / self._cfg["dt_max"] * (1.0 - 1e-12))
+        if not n <= self._if.MAX_SUBSTEPS:
+            dt_max = self._cfg["dt_max"]
+            self._report(STATUS_ERROR, f"communication step h = {h!r} s needs {float(n):.3g} substeps of at most "
+                         f"dt_max = {dt_max!r} s; at most {self._if.MAX_SUBSTEPS} are taken in one step (h <= "
+                         f"{self._if.MAX_SUBSTEPS * dt_max!r} s); step refused, state unchanged")
+            return False
         tau = float(self._v("friction_torque"))
         e = self._rk4(t, h, self._e, tau)
         w = self._schedule(t + h)[0] + e

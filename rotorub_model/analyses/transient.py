@@ -234,6 +234,19 @@ class CentralDifference:
     def velocity(self) -> np.ndarray:
         return (self.q - self.q_prev) / self.dt
 
+    def restart(self, dt: float, omega: float, omega_dot: float = 0.0) -> None:
+        """Go on with step dt at the current velocity (the two-step scheme restarted: q_prev = q - dt v). The
+        matrices for (omega, dt) are built first: if they cannot be (ParameterError), nothing has changed."""
+        old_dt, old_key = self.dt, self._key
+        self._s.dt = float(dt)
+        try:
+            self._matrices(omega, omega_dot)
+        except ParameterError:
+            self._s.dt, self._key = old_dt, old_key
+            raise
+        v = (self.q - self.q_prev) / old_dt if old_dt != 0.0 else np.zeros_like(self.q)
+        self.q_prev[:] = self.q - dt * v
+
 
 def rotate_to_fixed(v: np.ndarray, phi: np.ndarray | float) -> np.ndarray:
     """Rotate rotating-frame (x, y, ...) components by phi to the fixed frame (last axis)."""

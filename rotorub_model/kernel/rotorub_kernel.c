@@ -549,6 +549,10 @@ int rr_cd_run(rr_cd_job *job)
             ++written;
         }
     }
+    if (!s->diverged) { /* the state the last substep reached counts too: a step ends inside the limit or diverged */
+        for (k = 0; k < rows; ++k)
+            if (!(gaps[k] > floor_gap)) s->diverged = 1;
+    }
     s->steps += done;
     s->t += done * dt;
     s->phi += done * dt * omega;
