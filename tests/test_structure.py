@@ -661,3 +661,89 @@ def test_blade_euler_load_under_angular_acceleration(kinematics):
     load = -np.einsum("p,pki,pk->i", kin.dm, J, r0 @ ZMAT.T)  # per unit dOmega/dt
     got = model.force(0.0, me=0.0, omega_dot=1.0)[model.slices["rotor"]]
     np.testing.assert_allclose(got, load, rtol=1e-6, atol=1e-9 * np.abs(load).max())
+
+
+# ---------------------------------------------------------------------------
+# 9. cyclic symmetry: the free model solved block by block (structure/cyclic.py)
+# ---------------------------------------------------------------------------
+
+
+def _dense_modes(model, omega):
+    from rotorub_model.analyses.linear import first_order
+
+    lam, vec = np.linalg.eig(first_order(model, omega))
+    keep = lam.imag >= -1e-9
+    return lam[keep], vec[: model.n_dofs, keep]
+
+
+def _moved_disk_params():
+    from rotorub_model.structure.params import from_dict, to_dict
+
+    d = to_dict(reference_parameters())
+    d["disks"][0]["z"] = 0.15
+    return from_dict(d)
+
+
+@pytest.mark.parametrize("config", ["reference", "18 blades", "7 blades, 5 polynomials to 3 modes", "moved disk"])
+def test_blocks_give_the_dense_problems_modes(config):
+    """The eigenvalues of the blocks are those of the whole first-order problem at every speed, to round-off,
+    and every block mode is a pure travelling wave (one nodal-diameter index carries all its weight), so
+    its fixed-frame label is unambiguous; where the dense problem's eigenvalue is simple its label agrees."""
+    from rotorub_model.analyses.linear import _free_modes, harmonic_weights
+
+    p = {"reference": reference_parameters(),
+         "18 blades": reference_parameters().replace(blades={"count": 18}),
+         "7 blades, 5 polynomials to 3 modes": reference_parameters().replace(
+             blades={"count": 7, "n_ritz": 5, "n_modes": 3}),
+         "moved disk": _moved_disk_params()}[config]
+    model = build_model(p)
+    assert len(model.cyclic.blocks) > 3  # the model does split
+    for speed in (0.0, 1.7, 6.0):
+        omega = speed * p.normalisation.omega_ref
+        lam_d, vec_d = _dense_modes(model, omega)
+        lam_b, phi_b = _free_modes(model, np.array([omega]))[0]
+        assert lam_b.shape == lam_d.shape
+        scale = np.abs(lam_d).max()
+        assert max(np.min(np.abs(lam_d - x)) for x in lam_b) < 1e-11 * scale
+        assert max(np.min(np.abs(lam_b - x)) for x in lam_d) < 1e-11 * scale
+        r = run_modes(model, speed)
+        for i, x in enumerate(lam_b):
+            w = harmonic_weights(model, phi_b[:, i])
+            assert max(w.values()) >= (1 - 1e-9) * sum(w.values()), f"mode {x} is not one travelling wave"
+        for i, x in enumerate(lam_d):
+            d = np.abs(lam_d - x)
+            if np.sort(d)[1] > 1e-6 * abs(x):  # a simple eigenvalue: its mode is defined, and so its label
+                w = harmonic_weights(model, vec_d[:, i])
+                j = int(np.argmin(np.abs(r.eigenvalues - x)))
+                assert r.harmonic[j] == max(w, key=w.get)
+
+
+def test_a_model_that_is_not_cyclic_merges_blocks_and_stays_exact():
+    """One blade stiffer than the others (mistuning): the blade waves couple, the blocks merge, and the
+    block solution is still the dense problem's."""
+    import dataclasses
+
+    from rotorub_model.analyses.linear import _free_modes
+
+    model = build_model()
+    K = model.K.copy()
+    i = model.index("blade3.b1")
+    K[i, i] *= 1.05
+    mistuned = dataclasses.replace(model, K=K)
+    assert len(mistuned.cyclic.blocks) < len(model.cyclic.blocks)
+    omega = 2.0 * model.params.normalisation.omega_ref
+    lam_d, _ = _dense_modes(mistuned, omega)
+    lam_b, _ = _free_modes(mistuned, np.array([omega]))[0]
+    assert lam_b.shape == lam_d.shape
+    assert max(np.min(np.abs(lam_d - x)) for x in lam_b) < 1e-11 * np.abs(lam_d).max()
+
+
+def test_campbell_is_the_modes_at_each_speed():
+    from rotorub_model.analyses.linear import run_campbell
+
+    model = build_model()
+    c = run_campbell(model, speed_max=8.0, n_speeds=9)
+    for k, s in enumerate(c.speeds):
+        r = run_modes(model, float(s))
+        np.testing.assert_array_equal(c.harmonic[k], r.harmonic[: c.harmonic.shape[1]])
+        np.testing.assert_allclose(c.fixed_frame_hz[k], r.fixed_frame_hz[: c.harmonic.shape[1]], rtol=1e-12)

@@ -225,29 +225,112 @@ class ModesResult:
         return save_result(self, out, "modes")
 
 
-def run_modes(model: Model, speed: float, K_extra: np.ndarray | None = None) -> ModesResult:
-    """Eigenvalues at normalised speed ``speed`` with fixed-frame labelling."""
-    if not np.isfinite(speed) or speed < 0:
-        raise ParameterError(f"speed: {speed} out of range; accepted range [0, inf) (normalised)")
+def _weight_columns(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[int]]:
+    """What harmonic_weights reads, as arrays: (x dof of each (x, y) pair, its harmonic n, its mass, the
+    blade mass per function, the harmonic indices in harmonic_weights' order of first appearance, which
+    is the order max() breaks ties in)."""
+    Md = np.diag(model.M)
+    ix, hn = [], []
+    for i, name in enumerate(model.dofs):
+        if name.endswith(".x"):
+            ix.append(i)
+            hn.append(int(name.split(".")[1][1:]) if name.startswith("casing.n") else 1)
+    N, nb = model.params.blades.count, model.params.blades.dofs
+    keys: dict[int, None] = {}
+    for n in hn:
+        keys.setdefault(n)
+        keys.setdefault(-n)
+    for k in range(N):
+        keys.setdefault(-(k if k <= N // 2 else k - N))
+    mb = Md[model.slices["blades"]].reshape(N, nb)[0]
+    return np.array(ix, dtype=int), np.array(hn, dtype=int), Md[ix], mb, list(keys)
+
+
+def _labels(model: Model, lam: np.ndarray, phi: np.ndarray, omega: float, cols=None) -> tuple[np.ndarray, np.ndarray]:
+    """(fixed-frame frequency [Hz], nodal-diameter index) of every mode: harmonic_weights for all the
+    columns of phi (n, k) at once, the index its largest weight's."""
+    ix, hn, m, mb, keys = cols or _weight_columns(model)
+    col = {h: c for c, h in enumerate(keys)}
+    W = np.zeros((phi.shape[1], len(keys)))
+    x, y = phi[ix], phi[ix + 1]
+    fw, bw = m[:, None] * np.abs(x + 1j * y) ** 2 / 4, m[:, None] * np.abs(x - 1j * y) ** 2 / 4
+    for r, n in enumerate(hn):
+        W[:, col[n]] += fw[r]
+        W[:, col[-n]] += bw[r]
+    N = model.params.blades.count
+    bl = phi[model.slices["blades"]].reshape(N, mb.size, -1)
+    coef = np.fft.fft(bl, axis=0) / N
+    wk = np.einsum("f,kfm->km", mb, np.abs(coef) ** 2) * N
+    for k in range(N):
+        W[:, col[-(k if k <= N // 2 else k - N)]] += wk[k]
+    harm = np.array(keys)[np.argmax(W, axis=1)]
+    return np.abs(lam.imag + harm * omega) / (2 * np.pi), harm
+
+
+def _free_modes(model: Model, omegas: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(eigenvalues, mode shapes (n, k)) of the contact-open model at each speed, the half with Im >= 0 as
+    the dense problem's filter keeps it, solved per cyclic block (structure/cyclic.py): one block of each
+    conjugate pair (the other holds the conjugates), the blocks of one size at all the speeds in one
+    batched eigen-solve. The reference's real 76 x 76 problem becomes one complex 14 x 14 and a few 2 x 2
+    and 4 x 4."""
+    cb = model.cyclic
+    omegas = np.asarray(omegas, dtype=float)
+    S = len(omegas)
+    w = omegas[:, None, None]
+    solve = [i for i, j in enumerate(cb.conjugate) if i <= j]
+    lams: list[list[np.ndarray]] = [[] for _ in omegas]
+    phis: list[list[np.ndarray]] = [[] for _ in omegas]
+    for k in sorted({len(cb.blocks[i]) for i in solve}, reverse=True):
+        which = [i for i in solve if len(cb.blocks[i]) == k]
+        A = np.zeros((len(which), S, 2 * k, 2 * k), dtype=complex)
+        A[:, :, :k, k:] = np.eye(k)
+        for r, i in enumerate(which):
+            K0, Ks, K1, C0, C1 = cb.parts[i]
+            A[r, :, k:, :k] = -(K0 + w * w * Ks + w * K1)
+            A[r, :, k:, k:] = -(C0 + w * C1)
+        lam, vec = np.linalg.eig(A)
+        phi = np.einsum("nk,rskm->rsnm", cb.T[:, cb.blocks[which[0]]], vec[:, :, :k, :]) if len(which) == 1 else \
+            np.stack([np.einsum("nk,skm->snm", cb.T[:, cb.blocks[i]], vec[r, :, :k, :]) for r, i in enumerate(which)])
+        for r, i in enumerate(which):
+            paired = cb.conjugate[i] != i
+            for s in range(S):
+                la, ph = lam[r, s], phi[r, s]
+                up = la.imag >= -1e-9
+                lams[s].append(la[up])
+                phis[s].append(ph[:, up])
+                if paired:  # the conjugate block's modes: (conj lambda, conj phi)
+                    dn = la.imag <= 1e-9
+                    lams[s].append(la[dn].conj())
+                    phis[s].append(ph[:, dn].conj())
+    return [(np.concatenate(lams[s]), np.hstack(phis[s])) for s in range(S)]
+
+
+def _modes_at(model: Model, speed: float, lam: np.ndarray, phi: np.ndarray, cols=None) -> ModesResult:
     omega = speed * model.params.normalisation.omega_ref
-    lam, vec = np.linalg.eig(first_order(model, omega, K_extra))
-    n = model.n_dofs
-    keep = lam.imag >= -1e-9
-    lam, vec = lam[keep], vec[:n, keep]
-    order = np.argsort(np.abs(lam.imag))
-    lam, vec = lam[order], vec[:, order]
-    fixed = np.empty(lam.size)
-    harm = np.empty(lam.size, dtype=int)
-    for i in range(lam.size):
-        w = harmonic_weights(model, vec[:, i])
-        m = max(w, key=w.get)
-        harm[i] = m
-        fixed[i] = abs(lam[i].imag + m * omega) / (2 * np.pi)
+    keep = lam.imag >= -1e-9  # a conjugate pair once (the free modes come filtered already)
+    lam, phi = lam[keep], phi[:, keep]
+    order = np.argsort(np.abs(lam.imag), kind="stable")
+    lam, phi = lam[order], phi[:, order]
+    fixed, harm = _labels(model, lam, phi, omega, cols)
     # The damping ratio belongs to the motion an observer sees: a mode whose rotating-frame
     # frequency is near zero (the critical mode near its critical speed) would otherwise read
     # zeta ~ 1 from |lambda| ~ |Re lambda|, while in the fixed frame it whirls at ~Omega.
     zeta = -lam.real / np.maximum(np.hypot(lam.real, 2 * np.pi * fixed), 1e-300)
     return ModesResult(speed, lam, fixed, harm, zeta)
+
+
+def run_modes(model: Model, speed: float, K_extra: np.ndarray | None = None) -> ModesResult:
+    """Eigenvalues at normalised speed ``speed`` with fixed-frame labelling. The free model (no
+    ``K_extra``) is solved block by block (cyclic symmetry); with a contact stiffness, whole."""
+    if not np.isfinite(speed) or speed < 0:
+        raise ParameterError(f"speed: {speed} out of range; accepted range [0, inf) (normalised)")
+    omega = speed * model.params.normalisation.omega_ref
+    if K_extra is None:
+        lam, phi = _free_modes(model, np.array([omega]))[0]
+    else:
+        lam, vec = np.linalg.eig(first_order(model, omega, K_extra))
+        phi = vec[: model.n_dofs]
+    return _modes_at(model, float(speed), lam, phi)
 
 
 @dataclass
@@ -270,18 +353,21 @@ class CampbellResult:
     def plot(self, path: str | Path, fmax_hz: float | None = None) -> Path:
         plt = pyplot()
         fig, ax = plt.subplots(figsize=(7, 5))
-        sc = None
-        for j in range(self.fixed_frame_hz.shape[1]):
-            sc = ax.scatter(self.speeds, self.fixed_frame_hz[:, j], s=3, c=np.abs(self.harmonic[:, j]),
-                            cmap="tab10", vmin=0, vmax=9)
+        nd = np.abs(self.harmonic)
+        top = max(int(nd.max()), 1)
+        # one colour per nodal diameter (a discrete scale: colour means the index, not a shade of it)
+        cmap = pyplot().get_cmap("tab10" if top < 10 else "tab20", top + 1)
+        dots = 3 if len(self.speeds) > 100 else 8
+        S = np.repeat(self.speeds[:, None], nd.shape[1], axis=1)
+        sc = ax.scatter(S.ravel(), self.fixed_frame_hz.ravel(), s=dots, c=nd.ravel(), cmap=cmap, vmin=-0.5,
+                        vmax=top + 0.5, linewidths=0)
         ax.plot(self.speeds, self.speeds * self.omega_ref / (2 * np.pi), "k--", lw=1, label="1X (synchronous)")
         fmax = fmax_hz or 1.3 * self.speeds[-1] * self.omega_ref / (2 * np.pi)
         ax.set_ylim(0, fmax)
         ax.set_xlabel("normalised spin speed Ω / Ω_ref")
         ax.set_ylabel("fixed-frame frequency [Hz]")
-        ax.set_title("Campbell diagram (colour: |nodal diameter|)")
-        if sc is not None:
-            fig.colorbar(sc, ax=ax, label="|nodal diameter|")
+        ax.set_title(f"Campbell diagram ({len(self.speeds)} speeds)")
+        fig.colorbar(sc, ax=ax, label="|nodal diameter index|", ticks=range(top + 1))
         ax.legend(loc="upper left")
         ax.grid(alpha=0.3)
         return save_figure(fig, path)
@@ -295,8 +381,9 @@ def run_campbell(model: Model, speed_max: float = 10.0, n_speeds: int = 60) -> C
     _check_speed_range(1e-9, speed_max, max(n_speeds, 10))
     speeds = np.linspace(0.0, speed_max, n_speeds)
     rows_f, rows_r, rows_h = [], [], []
-    for s in speeds:
-        r = run_modes(model, float(s))
+    cols = _weight_columns(model)
+    for s, (lam, phi) in zip(speeds, _free_modes(model, speeds * model.params.normalisation.omega_ref)):
+        r = _modes_at(model, float(s), lam, phi, cols)
         rows_f.append(r.fixed_frame_hz)
         rows_r.append(r.eigenvalues.imag / (2 * np.pi))
         rows_h.append(r.harmonic)

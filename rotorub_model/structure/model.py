@@ -76,6 +76,14 @@ class Model:
         return self.dofs.index(name)
 
     @cached_property
+    def cyclic(self):
+        """The contact-open model's cyclic-symmetry blocks (structure/cyclic.py): what the eigen-analyses
+        of the free rotor solve instead of the whole problem."""
+        from .cyclic import cyclic_blocks
+
+        return cyclic_blocks(self)
+
+    @cached_property
     def M_inv(self) -> np.ndarray:
         """M^-1 (every first-order system and eigen-analysis needs it; the model's matrices do not change)."""
         return np.linalg.inv(self.M)
