@@ -62,3 +62,34 @@ def test_quasi_static_sweep_goes_on_past_a_diverged_point(fmu, ref_model, tmp_pa
     assert (n < 0).any(), n  # some points diverged ...
     first_bad = int(np.argmax(n < 0))
     assert (n[first_bad:] >= 0).any(), n  # ... and the sweep solved points after them
+
+
+def test_quasi_static_map_hatches_unstable_cells_cell_by_cell(monkeypatch, tmp_path):
+    """Issue 18.7: the hatch marks exactly the unstable cells (a contour of the boolean spilled it half a cell
+    into the neighbours, one stroke a cell apart), densely; cells without a balanced solution get their own
+    legend entry, and the legend sits below the axes."""
+    from matplotlib.patches import Rectangle
+
+    from rotorub_model.results import pyplot
+
+    speeds, g0s = np.linspace(3.0, 3.8, 5), np.array([0.0, 0.5e-3, 1e-3, 2e-3])
+    n = np.array([[3, 2, 0, 0], [4, 3, 1, 0], [5, 3, 2, 0], [5, 4, -1, 0], [4, 2, 0, 0]])
+    re = np.where(n > 0, -1.0, np.nan)
+    re[1, 1] = re[2, 0] = re[3, 1] = 0.5
+    m = harness.QuasiStaticMaps(speeds, g0s, {"2D": n}, {"2D": re})
+    figs = []
+    monkeypatch.setattr(harness, "save_figure", lambda fig, path, **kw: figs.append(fig) or path)
+    m.plot(tmp_path / "maps.png")
+    fig = figs[0]
+    ax = fig.axes[0]
+    hatched = [p for p in ax.patches if isinstance(p, Rectangle) and p.get_hatch()]
+    assert len(hatched) == 3 and all(len(p.get_hatch()) >= 5 for p in hatched)
+    centres = sorted((round(p.get_x() + p.get_width() / 2, 9), round(p.get_y() + p.get_height() / 2, 9))
+                     for p in hatched)
+    assert centres == sorted((round(speeds[i], 9), round(g0s[j] * 1e3, 9)) for i, j in ((1, 1), (2, 0), (3, 1)))
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert any(lab.startswith("unstable") for lab in labels) and any("no balanced solution" in lab for lab in labels)
+    fig.canvas.draw()
+    r = fig.canvas.get_renderer()
+    assert not fig.legends[0].get_window_extent(r).overlaps(ax.get_window_extent(r))
+    pyplot().close(fig)

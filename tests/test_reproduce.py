@@ -43,3 +43,57 @@ def test_report_references_existing_figures(run):
     for f in summary["paper_facts"]:
         if not f["holds"]:
             assert f"Fact {f['id']}" in text
+
+
+def test_report_and_summary_record_their_inputs(run):
+    """Issue 18.7: the parameter source and its hash, the grid and the package version, in both."""
+    import hashlib
+
+    import rotorub_model
+    from rotorub_model.structure.params import REFERENCE_FILE
+
+    out, _ = run
+    inp = json.loads((out / "summary.json").read_text())["inputs"]
+    ref_hash = hashlib.sha256(REFERENCE_FILE.read_bytes()).hexdigest()
+    assert inp["parameters"]["source"] == "embedded reference" and inp["parameters"]["sha256"] == ref_hash
+    assert inp["grid"]["mode"] == "quick"
+    assert (inp["grid"]["stability_maps"]["n_speeds"], inp["grid"]["stability_maps"]["n_g0"]) == (40, 36)
+    assert inp["package_version"] == rotorub_model.__version__
+    text = (out / "report.md").read_text()
+    assert ref_hash in text and "embedded reference" in text and inp["parameters"]["values_sha256"] in text
+    assert "**quick**" in text and "40 speeds" in text and "36 clearances" in text
+    assert f"rotorub_model {rotorub_model.__version__}" in text
+
+
+def test_report_facts_are_prose_not_key_value_dumps(run):
+    out, _ = run
+    text = (out / "report.md").read_text()
+    table = text.split("## The paper's facts")[1].split("\n## ")[0]
+    rows = [ln for ln in table.splitlines() if re.match(r"\| (\d|6[ab]) \|", ln)]
+    assert len(rows) == 7
+    for row in rows:
+        paper, ours = row.split(" | ")[2:4]
+        for cell in (paper, ours):
+            assert "{" not in cell and "[" not in cell and "True" not in cell and "False" not in cell, cell
+            # a summary key ('closure_2d_max_mm: ...') is a dump; words and units are not
+            assert not re.search(r"\b[a-z0-9]{2,}(_[a-z0-9]+)+\b", cell), cell
+    assert "critical speeds at Ω = " in rows[0] and "blades in contact" in rows[4]
+
+
+def test_parameter_source_of_a_file(write_params, ref_params):
+    """A parameter file: its path, the sha256 of its bytes, and whether the model was built from it."""
+    import hashlib
+
+    from rotorub_model.app.reproduce import parameter_source
+    from rotorub_model.structure.params import to_dict
+
+    d = to_dict(ref_params)
+    d["contact"]["k_r"] *= 10
+    path = write_params(d, "stiff.toml")
+    stiff = build_model(ref_params.replace(contact={"k_r": d["contact"]["k_r"]}))
+    src = parameter_source(stiff, path)
+    assert src["source"] == str(path) and src["sha256"] == hashlib.sha256(path.read_bytes()).hexdigest()
+    assert src["file_matches_model"] is True
+    assert parameter_source(build_model(), path)["file_matches_model"] is False
+    mem = parameter_source(stiff)  # no file: only the values identify the configuration
+    assert mem["absolute_path"] is None and mem["sha256"] == mem["values_sha256"] == src["values_sha256"]

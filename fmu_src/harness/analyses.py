@@ -90,19 +90,55 @@ class QuasiStaticMaps:
         return out
 
     def plot(self, path: str | Path) -> Path:
+        """Blades in contact per cell (a discrete colour scale); unstable cells hatched cell by cell (a
+        contour of the boolean spilled the hatch half a cell into its neighbours, in lines a cell apart);
+        cells the FMU found no balanced solution for in grey."""
+        from matplotlib.colors import BoundaryNorm, ListedColormap
+        from matplotlib.patches import Patch, Rectangle
 
         plt = pyplot()
-        fig, axes = plt.subplots(1, len(self.n_contact), figsize=(11, 4.2), sharey=True)
-        for ax, (f, n) in zip(np.atleast_1d(axes), self.n_contact.items()):
-            S, G = np.meshgrid(self.speeds, self.g0s * 1e3, indexing="ij")
-            pc = ax.pcolormesh(S, G, np.where(n > 0, n, np.nan), shading="nearest", cmap="viridis")
-            re = np.nan_to_num(self.max_real[f], nan=-1)
-            ax.contourf(S, G, (n > 0) & (re > 1e-6), levels=[0.5, 1.5], hatches=["///"], colors="none")
-            ax.set_title(f"{f} through the FMU (hatched: unstable)")
-            ax.set_xlabel("Ω / Ω_ref")
-            fig.colorbar(pc, ax=ax, label="blades in contact")
-        np.atleast_1d(axes)[0].set_ylabel("g0 [mm]")
-        return save_figure(fig, path)
+        forms = list(self.n_contact)
+        fig, axes = plt.subplots(1, len(forms), figsize=(11.5, 4.6), sharey=True, squeeze=False)
+        axes = axes[0]
+        nmax = max(max(int(n.max()) for n in self.n_contact.values()), 1)
+        cmap = ListedColormap(plt.get_cmap("viridis")(np.linspace(0.0, 1.0, nmax)))
+        norm = BoundaryNorm(np.arange(0.5, nmax + 1.0), nmax)
+        se, ge = _cell_edges(self.speeds), _cell_edges(self.g0s * 1e3)
+        for ax, f in zip(axes, forms):
+            n = self.n_contact[f]
+            pc = ax.pcolormesh(se, ge, np.where(n > 0, n, np.nan).T, cmap=cmap, norm=norm)
+            ax.pcolormesh(se, ge, np.where(n < 0, 1.0, np.nan).T, cmap=ListedColormap([NO_SOLUTION_COLOUR]))
+            unstable = (n > 0) & (np.nan_to_num(self.max_real[f], nan=-1) > 1e-6)
+            with plt.rc_context({"hatch.linewidth": 0.7}):
+                for i, j in np.argwhere(unstable):
+                    r, g, b, _ = cmap(norm(n[i, j]))
+                    ink = "k" if 0.299 * r + 0.587 * g + 0.114 * b > 0.45 else "w"  # visible on dark cells too
+                    ax.add_patch(Rectangle((se[i], ge[j]), se[i + 1] - se[i], ge[j + 1] - ge[j], fill=False,
+                                           hatch=UNSTABLE_HATCH, edgecolor=ink, lw=0.0))
+            ax.set_title(f"{f}: static solutions through the FMU")
+            ax.set_xlabel("normalised spin speed Ω / Ω_ref [-]")
+            fig.colorbar(pc, ax=ax, label="blades in contact [-]", ticks=range(1, nmax + 1))
+        axes[0].set_ylabel("initial clearance g0 [mm]")
+        handles = [Patch(facecolor="0.75", edgecolor="k", hatch=UNSTABLE_HATCH, label="unstable (max Re(λ) > 0)"),
+                   Patch(facecolor="white", edgecolor="0.6", label="no contact")]
+        if any((n < 0).any() for n in self.n_contact.values()):
+            handles.append(Patch(facecolor=NO_SOLUTION_COLOUR, label="no balanced solution found (FMU step discarded)"))
+        fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8.5, frameon=False)
+        fig.tight_layout(rect=(0, 0.07, 1, 1))
+        return save_figure(fig, path, layout=False)
+
+
+UNSTABLE_HATCH = "//////"  # six strokes per hatch unit: a few per cell even on a fine map
+NO_SOLUTION_COLOUR = "#9a9a9a"
+
+
+def _cell_edges(x: np.ndarray) -> np.ndarray:
+    """Edges of cells centred on x (midpoints inside, half a spacing beyond the ends)."""
+    x = np.asarray(x, dtype=float)
+    if x.size == 1:
+        return np.array([x[0] - 0.5, x[0] + 0.5])
+    mid = 0.5 * (x[1:] + x[:-1])
+    return np.concatenate([[x[0] - (mid[0] - x[0])], mid, [x[-1] + (x[-1] - mid[-1])]])
 
 
 def quasi_static_maps(fmu: str | Path, model, speeds: np.ndarray, g0s: np.ndarray, workdir: str | Path,
@@ -239,18 +275,17 @@ def _rel_diff(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def _plot_forces(runs: dict[str, FMURun], path: Path, title: str, diverged: dict[str, bool]) -> Path:
+    """One panel per formulation; a blade keeps its colour in every panel, legends right of the data."""
+    from rotorub_model.results import legend_outside, plot_blade_forces
 
     plt = pyplot()
-    fig, axes = plt.subplots(len(runs), 1, figsize=(8, 3 * len(runs)), sharex=True, squeeze=False)
+    fig, axes = plt.subplots(len(runs), 1, figsize=(9, 3 * len(runs)), sharex=True, squeeze=False)
     for ax, (f, r) in zip(axes[:, 0], runs.items()):
-        for j in range(r.F_N.shape[1]):
-            if r.F_N[:, j].max() > 0:
-                ax.plot(r.t, r.F_N[:, j], lw=0.8, label=f"blade {j + 1}")
-        ax.set_ylabel("F_N [N]")
+        plot_blade_forces(ax, r.t, r.F_N, lw=0.8)
+        ax.set_ylabel("normal contact force F_N [N]")
         ax.set_title(f"{f}: {title}" + (" — diverged" if diverged[f] else ""))
         ax.grid(alpha=0.3)
-        if ax.get_legend_handles_labels()[0]:
-            ax.legend(fontsize=7, ncol=3)
+        legend_outside(ax)
     axes[-1, 0].set_xlabel("time [s]")
     return save_figure(fig, path)
 
@@ -327,22 +362,22 @@ def run_up(fmu: str | Path, model, out: str | Path, speed_from: float = 2.6, spe
     lib = run_transient(model, make_contact(model, formulation, g0=g0), omega_of_t, t_end=duration, t_ramp=0.0,
                         me=me, record_dt=h, hold=h)
 
+    from rotorub_model.results import legend_outside, plot_blade_forces
+
     plt = pyplot()
-    fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
-    axes[0].plot(r.t, r.omega / w_ref, lw=1)
-    axes[0].set_ylabel("Ω / Ω_ref (input)")
-    for j in range(r.F_N.shape[1]):
-        if r.F_N[:, j].max() > 0:
-            axes[1].plot(r.t, r.F_N[:, j], lw=0.6)
-    axes[1].set_ylabel("F_N per blade [N]")
+    fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
+    axes[0].plot(r.t, r.omega / w_ref, lw=1, color="0.2", label="Ω(t), the FMU's input")
+    axes[0].set_ylabel("spin speed Ω / Ω_ref [-]")
+    plot_blade_forces(axes[1], r.t, r.F_N, lw=0.6)
+    axes[1].set_ylabel("normal contact force F_N [N]")
     axes[2].plot(r.t, np.hypot(*r.disk.T) * 1e3, lw=0.8, label="FMU")
     axes[2].plot(lib.t, np.hypot(*lib.outputs["disk_fixed"].T) * 1e3, "--", lw=0.8, label="library")
     axes[2].set_ylabel("fan-disk displacement [mm]")
     axes[2].set_xlabel("time [s]")
-    axes[2].legend()
     axes[0].set_title(f"{formulation} run-up through the first critical speed through the FMU, g0 = {g0 * 1e3:g} mm")
     for ax in axes:
         ax.grid(alpha=0.3)
+        legend_outside(ax)
     save_figure(fig, out / "run_up.png")
     k_peak = int(np.argmax(np.hypot(*r.disk.T))) if len(r.t) else 0
     summary = {

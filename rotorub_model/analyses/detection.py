@@ -222,78 +222,128 @@ class DetectionResult:
         return s
 
     # ------------------------------------------------------------------ figures
+    # Fills come from the closures (the contact set at a speed is exactly g0 < c(Omega)), not from the
+    # boolean grid, so a thin band is drawn as thin as it is. The 3D set contains the 2D one: drawn
+    # opaque on top, 2D vanishes; under it, 3D did (the figure before this). So 2D is the flat fill
+    # at the bottom and 3D a hatch over it: where both detect, the orange shows through the hatch.
+    COLOURS = {"2D": "#f4a261", "2D line": "#b3541e", "3D": "#1d3f8a"}
+    Z_2D, Z_3D = 1.0, 2.0  # fill z-orders; each formulation's closure line just above its own fill
 
-    def _layers(self, ax, layers: list[tuple[str, str, str]], ymax_mm: float) -> None:
-        """Draw boolean maps in order (first = bottom) with their closure contour."""
-        from matplotlib.colors import ListedColormap
+    def _zoom(self) -> tuple[float, float]:
+        """Speed window around the first critical where the closures separate (its peak is ~1 % wide)."""
+        c = self.critical_speeds[0] if self.critical_speeds else float(self.speeds[np.argmax(self.closures["3D"])])
+        return max(c * 0.94, float(self.speeds[0])), min(c * 1.06, float(self.speeds[-1]))
 
-        g_mm = self.g0 * 1e3
-        for label, colour, name in layers:
-            M = self.map(label)
-            ax.pcolormesh(self.speeds, g_mm, np.ma.masked_where(~M.T, M.T), cmap=ListedColormap([colour]),
-                          shading="nearest", rasterized=True)
-            ax.plot(self.speeds, self.closures[label] * 1e3, color=colour, lw=0.8, label=name)
+    def _crit_lines(self, ax) -> None:
         for c in self.critical_speeds:
-            ax.axvline(c, color="k", ls=":", lw=0.8)
-        ax.set_xlim(self.speeds[0], self.speeds[-1])
-        ax.set_ylim(0.0, ymax_mm)
-        ax.set_xlabel("normalised spin speed Ω / Ω_ref")
-        ax.set_ylabel("nominal clearance g0 [mm]")
-        ax.grid(alpha=0.3)
+            ax.axvline(c, color="0.3", ls=":", lw=0.8, zorder=0.5)
 
-    def _ymax(self, labels: list[str]) -> float:
-        return min(1.1 * max(float(np.max(self.closures[k])) for k in labels) * 1e3, float(self.g0[-1]) * 1e3)
+    def _speed_axis(self, ax, window: tuple[float, float] | None = None) -> None:
+        ax.set_xlim(*(window or (self.speeds[0], self.speeds[-1])))
+        ax.set_xlabel("normalised spin speed Ω / Ω_ref [-]")
+        ax.grid(alpha=0.3, which="both")
+
+    def _draw_2d_3d(self, ax, window: tuple[float, float] | None = None) -> None:
+        s, c2, c3 = self.speeds, self.closures["2D"] * 1e3, self.closures["3D"] * 1e3
+        ax.fill_between(s, 0.0, c2, facecolor=self.COLOURS["2D"], edgecolor="none", zorder=self.Z_2D,
+                        label="2D contact area", gid="2D")
+        ax.fill_between(s, 0.0, c3, facecolor="none", edgecolor=self.COLOURS["3D"], hatch="////", lw=0.0,
+                        zorder=self.Z_3D, label="3D contact area (hatched, over 2D)", gid="3D")
+        ax.plot(s, c2, color=self.COLOURS["2D line"], lw=1.0, zorder=self.Z_2D + 0.5, label="2D closure", gid="2D")
+        ax.plot(s, c3, color=self.COLOURS["3D"], lw=1.2, zorder=self.Z_3D + 0.5, label="3D closure", gid="3D")
+        self._crit_lines(ax)
+        lo, hi = window or (s[0], s[-1])
+        sel = (s >= lo) & (s <= hi)
+        ax.set_ylim(0.0, 1.08 * float(np.max(c3[sel])))
+        ax.set_ylabel("nominal clearance g0 [mm]")
+        self._speed_axis(ax, window)
+
+    def _draw_sweep(self, axes, study: str) -> None:
+        """(a) the closures near the first critical; (b) their excess over the 2D closure, whole range."""
+        plt = pyplot()
+        if study == "theta":
+            values, labels = self.thetas_deg, [self.theta_label(t) for t in self.thetas_deg]
+            names = [f"θ = {t:g}°" for t in values]
+        else:
+            values, labels = self.chords_m, [self.chord_label(c) for c in self.chords_m]
+            names = [f"l_c = {c * 100:g} cm" for c in values]
+        # five nested curves: an ordered palette for the order, a line style and a marker each so that
+        # they stay apart where they run close (and in grey print); markers evenly spaced along the drawn
+        # line (markevery as a fraction), the speed grid being dense at the criticals
+        colours = plt.get_cmap("viridis")(np.linspace(0.0, 0.85, len(labels)))
+        styles = ["-", "--", "-.", ":", (0, (5, 1, 1, 1, 1, 1))]
+        markers = ["o", "s", "^", "D", "v"]
+        window = self._zoom()
+        s = self.speeds
+        sel = (s >= window[0]) & (s <= window[1])
+        c2 = self.closures["2D"]
+        for k, (lab, name) in enumerate(zip(labels, names)):
+            kw = {"color": colours[k], "ls": styles[k % len(styles)], "lw": 1.4, "marker": markers[k % len(markers)],
+                  "ms": 4.5, "label": f"{name} (max {np.max(self.closures[lab]) * 1e3:.2f} mm)"}
+            axes[0].plot(s[sel], self.closures[lab][sel] * 1e3, markevery=0.1, **kw)
+            kw.pop("label")
+            axes[1].plot(s, (self.closures[lab] - c2) * 1e3, markevery=0.08, **kw)
+        axes[0].plot(s[sel], c2[sel] * 1e3, color="k", ls="--", lw=1.0, label=f"2D (max {np.max(c2) * 1e3:.2f} mm)")
+        axes[0].set_ylabel("clearance closure c(Ω) [mm]")
+        axes[0].set_title("closures around the first critical speed")
+        axes[1].set_yscale("symlog", linthresh=1e-3)
+        axes[1].set_ylabel("closure − 2D closure [mm]")
+        axes[1].set_title("3D excess over 2D, whole speed range")
+        self._speed_axis(axes[0], window)
+        self._speed_axis(axes[1])
+        for ax in axes:
+            self._crit_lines(ax)
+
+    def figure(self, study: str = "2d_3d"):
+        """The figure of one study: '2d_3d', 'variants', 'theta', 'chord' (open: the caller saves or closes it)."""
+        plt = pyplot()
+        if study == "2d_3d":
+            fig, axes = plt.subplots(1, 2, figsize=(11, 4.3), gridspec_kw={"width_ratios": [1.6, 1]})
+            self._draw_2d_3d(axes[0])
+            self._draw_2d_3d(axes[1], self._zoom())
+            axes[0].set_title("Contact detection over the speed range")
+            axes[1].set_title("zoom on the first critical speed")
+            h, lab = axes[0].get_legend_handles_labels()
+            fig.legend(h, lab, loc="lower center", ncol=4, fontsize=8.5, frameon=False)
+            fig.tight_layout(rect=(0, 0.08, 1, 1))
+        elif study == "variants":
+            fig, (ax, bx) = plt.subplots(2, 1, figsize=(8, 7.5), sharex=True)
+            self._draw_2d_3d(ax)
+            var = (("3D geometry only", "C2", "--"), ("3D kinematics only", "C4", "-."))
+            for lab, col, ls in var:
+                ax.plot(self.speeds, self.closures[lab] * 1e3, color=col, ls=ls, lw=1.0, zorder=5,
+                        label=f"{lab} closure")
+            ax.set_xlabel("")
+            ax.set_title("Detection: full 3D over 2D, the degraded 3D closures (≈ 2D)")
+            ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+            c2 = self.closures["2D"]
+            for lab, col, ls in (("3D", self.COLOURS["3D"], "-"), *var):
+                bx.plot(self.speeds, (self.closures[lab] - c2) * 1e3, color=col, ls=ls, lw=1.0, label=f"{lab} − 2D")
+            self._crit_lines(bx)
+            bx.set_yscale("symlog", linthresh=1e-3)
+            bx.set_ylabel("closure difference [mm]")
+            bx.set_title("Closure difference with the 2D formulation (cf. paper Fig. 7)")
+            self._speed_axis(bx)
+            bx.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+            fig.tight_layout()
+        elif study in ("theta", "chord"):
+            fig, axes = plt.subplots(1, 2, figsize=(12, 4.6))
+            self._draw_sweep(axes, study)
+            what = (f"cone angle θ (chord {self.defaults.get('chord', 0) * 100:g} cm)" if study == "theta"
+                    else f"chord l_c (θ = {self.defaults.get('theta_deg', 0):g}°)")
+            fig.suptitle(f"3D detection, sweep of the {what}")
+            h, lab = axes[0].get_legend_handles_labels()
+            fig.legend(h, lab, loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize=8.5, frameon=False)
+            fig.tight_layout()
+        else:
+            raise ParameterError(f"study: '{study}' unknown; accepted: 2d_3d, variants, theta, chord")
+        return fig
 
     def plot(self, path: str | Path, study: str = "2d_3d") -> Path:
         """One figure per study: '2d_3d', 'variants', 'theta', 'chord'."""
-        plt = pyplot()
-        if study == "2d_3d":
-            fig, ax = plt.subplots(figsize=(7, 4.5))
-            self._layers(ax, [("3D", "#1f3b73", "3D (full)"), ("2D", "#8fb8e8", "2D")], self._ymax(["3D"]))
-            ax.set_title("Contact detection: 3D (dark) and 2D (light, on top)")
-            ax.legend(loc="upper right")
-        elif study == "variants":
-            fig, (ax, bx) = plt.subplots(2, 1, figsize=(7, 7), sharex=True)
-            self._layers(
-                ax,
-                [("3D", "#1f3b73", "3D (full)"), ("3D geometry only", "#4f7fc0", "3D geometry only"),
-                 ("3D kinematics only", "#79a6dc", "3D kinematics only"), ("2D", "#b9d5f2", "2D")],
-                self._ymax(["3D"]),
-            )
-            ax.set_xlabel("")
-            ax.set_title("Detection maps: full and degraded 3D, 2D on top")
-            ax.legend(loc="upper right", fontsize=8)
-            c2 = self.closures["2D"]
-            for lab, col in (("3D", "#1f3b73"), ("3D geometry only", "C1"), ("3D kinematics only", "C2")):
-                bx.plot(self.speeds, (self.closures[lab] - c2) * 1e3, color=col, lw=1.0, label=f"{lab} − 2D")
-            for c in self.critical_speeds:
-                bx.axvline(c, color="k", ls=":", lw=0.8)
-            bx.set_yscale("symlog", linthresh=1e-3)
-            bx.set_xlabel("normalised spin speed Ω / Ω_ref")
-            bx.set_ylabel("closure difference [mm]")
-            bx.set_title("Closure difference with the 2D formulation (cf. paper Fig. 7)")
-            bx.grid(alpha=0.3, which="both")
-            bx.legend(loc="upper right", fontsize=8)
-        elif study in ("theta", "chord"):
-            fig, ax = plt.subplots(figsize=(7, 4.5))
-            if study == "theta":
-                labels = [self.theta_label(t) for t in self.thetas_deg]
-                names = [f"θ = {t:g}°" for t in self.thetas_deg]
-                what = f"cone angle θ (chord {self.defaults.get('chord', 0) * 100:g} cm)"
-            else:
-                labels = [self.chord_label(c) for c in self.chords_m]
-                names = [f"l_c = {c * 100:g} cm" for c in self.chords_m]
-                what = f"chord l_c (θ = {self.defaults.get('theta_deg', 0):g}°)"
-            order = np.argsort([-float(np.max(self.closures[k])) for k in labels])  # widest at the bottom
-            shades = plt.get_cmap("Blues")(np.linspace(0.95, 0.35, len(labels)))
-            layers = [(labels[i], shades[r], names[i]) for r, i in enumerate(order)]
-            self._layers(ax, layers, self._ymax(labels))
-            ax.plot(self.speeds, self.closures["2D"] * 1e3, "k--", lw=0.8, label="2D")
-            ax.set_title(f"3D detection maps, sweep of the {what}")
-            ax.legend(loc="upper right", fontsize=8)
-        else:
+        if study not in ("2d_3d", "variants", "theta", "chord"):
             raise ParameterError(f"study: '{study}' unknown; accepted: 2d_3d, variants, theta, chord")
-        return save_figure(fig, path)
+        return save_figure(self.figure(study), path, layout=False)
 
     def save(self, out: str | Path) -> dict:
         """Write detection_{2d_3d,variants,theta,chord}.png, summary.json, detection.npz into ``out``."""

@@ -150,29 +150,43 @@ class BladeConvergence:
         return "\n".join(rows)
 
     def plot(self, path: str | Path) -> Path:
+        """Error against n: one colour per number of functions in both panels (flap solid, lag dashed; the
+        reduced bases in their n_ritz's colour, a line style and marker per n_modes), legends outside."""
+        from ..results import legend_outside
+
         plt = pyplot()
-        fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+        fig, axes = plt.subplots(1, 2, figsize=(12, 4.4))
+        ns = sorted({*self.n_values, *(nr for nr, _ in self.reduced)} - {N_CONVERGED})
+        colour = dict(zip(ns, plt.get_cmap("viridis")(np.linspace(0.0, 0.9, len(ns)))))
+        colour[N_CONVERGED] = "k"
+        floor = 1e-6  # [%] where an error below the plot's resolution is drawn (log axis)
         for n in self.n_values:
             if n == N_CONVERGED:
                 continue
-            axes[0].semilogy(self.mus, np.abs(self.error("flap", n)) * 100 + 1e-6, "-", label=f"flap, n={n}")
-            axes[0].semilogy(self.mus, np.abs(self.error("lag", n)) * 100 + 1e-6, "--", label=f"lag, n={n}")
-            axes[1].semilogy(self.speeds, np.abs(self.error("blade", n)) * 100 + 1e-6, label=f"n={n}")
-        axes[0].set_xlabel("mu = Omega / sqrt(EI / rho A l^4)")
-        axes[0].set_ylabel("error of the first frequency [%]")
+            axes[0].semilogy(self.mus, np.abs(self.error("flap", n)) * 100 + floor, "-", color=colour[n], lw=1.4,
+                             label=f"n_ritz = {n}")
+            axes[0].semilogy(self.mus, np.abs(self.error("lag", n)) * 100 + floor, "--", color=colour[n], lw=1.4)
+            axes[1].semilogy(self.speeds, np.abs(self.error("blade", n)) * 100 + floor, "-", color=colour[n], lw=1.4,
+                             label=f"n_ritz = {n} (all kept)")
+        axes[0].set_xlabel("μ = Ω / √(EI / ρA l⁴) [-]")
+        axes[0].set_ylabel("|error| of the first frequency [%]")
         axes[0].set_title("uniform rotating cantilever (hub radius 0)")
+        axes[0].plot([], [], color="0.3", ls="-", label="flap (solid)")  # the line styles' key
+        axes[0].plot([], [], color="0.3", ls="--", label="lag (dashed)")
         ref = self.reduced[(N_CONVERGED, N_CONVERGED)][0][:, 0]
+        styles = {2: (":", "o"), 3: ("-.", "s"), 4: ((0, (1, 1, 3, 1)), "^")}
         for (nr, nm), (f, _) in self.reduced.items():
             if nm < nr:
-                axes[1].semilogy(self.speeds, np.abs(f[:, 0] / ref - 1) * 100 + 1e-6, ":",
-                                 label=f"n_ritz={nr}, n_modes={nm}")
-        axes[1].set_xlabel("spin speed [rad/s]")
-        axes[1].set_ylabel("error of the first frequency [%]")
-        axes[1].set_title(f"the configuration's blade (model: n_ritz={self.model_basis[0]}, "
-                          f"n_modes={self.model_basis[1]})")
+                ls, mk = styles.get(nm, ("--", "x"))
+                axes[1].semilogy(self.speeds, np.abs(f[:, 0] / ref - 1) * 100 + floor, ls=ls, marker=mk, ms=3.5,
+                                 color=colour.get(nr, "0.4"), lw=1.2, label=f"n_ritz = {nr}, n_modes = {nm}")
+        axes[1].set_xlabel("spin speed Ω [rad/s]")
+        axes[1].set_ylabel("|error| of the first frequency [%]")
+        axes[1].set_title(f"the configuration's blade (model: n_ritz = {self.model_basis[0]}, "
+                          f"n_modes = {self.model_basis[1]})")
         for ax in axes:
             ax.grid(alpha=0.3, which="both")
-            ax.legend(fontsize=7)
+            legend_outside(ax)
         return save_figure(fig, path)
 
     def save(self, out: str | Path) -> dict:

@@ -2,12 +2,27 @@
 
 At each speed the static solution is continued from the largest clearance (no
 contact: the linear response) down to the smallest, each solve warm-started from
-the previous one. Where no equilibrium is found (Newton cycling between contact
-sets, which for a piecewise-linear residual means the static stiffness changes
-sign between them: no static solution nearby), the cell is marked (n_contact = -1,
-grey in the figures) and left out of every fraction. Per point: blades in contact, total chord in contact (3D),
-the largest real part and the sum of positive real parts of the eigenvalues of
-eq. (11), and whether Newton converged.
+the previous one. Past a fold of that branch (near the critical speed the contact
+stiffening bends the resonance) Newton from the warm start, and the solver's own
+restarts, can all fail although an equilibrium exists on another branch: measured
+on the quick grid, every such cell of the reference (19 in 2D, 13 in 3D) and of a
+ten times stiffer contact (62 and 66) has one. There the row tries contact-set
+starts (:class:`ContactSetStarts`): with a chosen set of blades in full contact the
+law is affine in q, so the balanced solution of that set is one linear solve; the
+arcs of neighbouring blades (a whirl's contact patch) are solved in one batch, a 2D
+set whose gaps agree with it is an exact equilibrium, and the others (3D: partial
+chords are not affine) start Newton, most consistent first. What is still without
+a solution is marked, never counted as contact, and left out of every fraction:
+
+* ``NO_EQUILIBRIUM`` (n_contact = -2): proven absent. 2D only, where the law is
+  piecewise affine: every one of the 2^N contact sets was solved and none is
+  consistent with its own gaps (N <= ENUMERATE_MAX_BLADES);
+* ``NOT_CONVERGED`` (n_contact = -1): the solver found none; one may exist (every
+  failure of maps written before the contact-set starts is this).
+
+Per point: blades in contact, total chord in contact (3D), the largest real part and
+the sum of positive real parts of the eigenvalues of eq. (11), whether Newton
+converged, and whether a contact-set start found the solution.
 
 "stable strip" (summary): the contact region's boundary cells (contact cells with a
 non-contact neighbour on the grid) are mostly (>= 80 %) stable while unstable
@@ -16,19 +31,123 @@ cells exist inside: the paper's 3D picture of a stable band around the unstable 
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
-from ..contact import make_contact
+from ..contact import ContactModel, make_contact
 from ..results import pyplot, save_figure, save_result
 from ..structure.model import Model, build_model
 from ..structure.params import from_dict, to_dict
 from .stability import stability_indicators
-from .static import solve_static
+from .static import StaticResult, solve_static
 from .sweeps import run_tasks
+
+NOT_CONVERGED = -1  # n_contact of a cell where the solver found no equilibrium (one may exist)
+NO_EQUILIBRIUM = -2  # n_contact of a cell where no contact set admits one (2D enumeration: a proof)
+ENUMERATE_MAX_BLADES = 12  # 2^12 linear solves of the model's size per proof: ~0.1 s at 38 dofs
+NEWTON_STARTS = 16  # contact-set starts tried per cell in 3D (measured: the 8th at most was needed)
+ROW_SOLVER = "contact-set starts 1"  # in the task payload: rows saved by an older row solver are not reused
+GAP_TOL = 1e-13  # [m] a set's gaps agree with it within this (rounding of a 1e-3 m gap)
+STABLE_STRIP_MIN = 0.8  # stable share (by area) of the contact region's boundary cells that makes a "stable strip"
+
+
+class ContactSetStarts:
+    """Balanced solutions of chosen contact sets at one speed: blades in the set in full contact
+    (2D: the tip; 3D: both edges), the others free. Each set's law is affine in q and g0,
+    F(q) = sum_j (J_j q + g0 h_j), with J_j, h_j from the kernel's law on blade j alone."""
+
+    def __init__(self, model: Model, base: ContactModel, omega: float):
+        self.model, self.base, self.omega = model, base, omega
+        g, P = base.geometry, base.n_points
+        z = np.zeros(model.n_dofs)
+        J, h = [], []
+        for j in range(base.n_blades):
+            rows = slice(j * P, (j + 1) * P)
+            one = dataclasses.replace(g, points=g.points[j:j + 1], normals=g.normals[j:j + 1],
+                                      tangents=g.tangents[j:j + 1], Jb=g.Jb[j:j + 1], Jc=g.Jc[j:j + 1],
+                                      G=g.G[rows], A=g.A[j:j + 1], B=g.B[j:j + 1], S=g.S[rows])
+            # g0 = -1 closes the blade at q = 0, where its force is -h
+            c = ContactModel(base.formulation, base.variant, one, -1.0, base.k_r, base.mu, base.v_slip)
+            J.append(c.jacobian(z, omega))
+            h.append(-c.forces(z, omega))
+        self.J, self.h = np.array(J), np.array(h)
+        self.K = model.K_omega(omega)
+        self.F = model.force(omega)
+
+    def arcs(self) -> np.ndarray:
+        """Membership (n_sets, N) of every arc of neighbouring blades, and of the empty set."""
+        N = self.base.n_blades
+        sets = [np.zeros(N)]
+        for length in range(1, N + 1):
+            for first in range(N if length < N else 1):
+                s = np.zeros(N)
+                s[(first + np.arange(length)) % N] = 1.0
+                sets.append(s)
+        return np.array(sets)
+
+    def every_set(self) -> np.ndarray:
+        N = self.base.n_blades
+        bits = np.arange(1 << N)
+        return ((bits[:, None] >> np.arange(N)) & 1).astype(float)
+
+    def solve(self, member: np.ndarray, g0: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
+        """(q, consistent, violation, all_regular) of each set: consistent where the set's blades
+        penetrate at every point and the others at none (within GAP_TOL); violation [m] the sum of
+        the gaps that disagree; all_regular False where a set's system is singular (a continuum of
+        solutions, or none: no verdict on that set)."""
+        n = self.model.n_dofs
+        qs, regular = np.zeros((len(member), n)), np.ones(len(member), dtype=bool)
+        for lo in range(0, len(member), 1024):  # batches bound the memory (1024 x n x n)
+            m = member[lo:lo + 1024]
+            A = self.K[None] - np.einsum("sj,jab->sab", m, self.J)
+            b = self.F[None] + g0 * (m @ self.h)
+            try:
+                qs[lo:lo + len(m)] = np.linalg.solve(A, b[..., None])[..., 0]
+            except np.linalg.LinAlgError:
+                for k in range(len(m)):
+                    try:
+                        qs[lo + k] = np.linalg.solve(A[k], b[k])
+                    except np.linalg.LinAlgError:
+                        regular[lo + k] = False
+        gaps = self.base.with_clearance(g0).gaps_batch(qs)  # (sets, N, P)
+        inside = member > 0
+        closed = (gaps < GAP_TOL).all(axis=2)
+        free = (gaps > -GAP_TOL).all(axis=2)
+        consistent = np.all(np.where(inside, closed, free), axis=1) & regular
+        violation = np.where(inside, np.clip(gaps.max(axis=2), 0, None), np.clip(-gaps.min(axis=2), 0, None)).sum(1)
+        violation[~regular] = np.inf
+        return qs, consistent, violation, bool(regular.all())
+
+    def find(self, g0: float, near: np.ndarray | None) -> tuple[StaticResult | None, bool]:
+        """(equilibrium or None, proven_absent) at clearance g0; of several, the one nearest ``near``."""
+        c = self.base.with_clearance(g0)
+        qs, ok, violation, _ = self.solve(self.arcs(), g0)
+        piecewise_affine = self.base.formulation == "2D"
+        if piecewise_affine and ok.any():
+            return self._polish(c, self._nearest(qs[ok], near)), False
+        for k in np.argsort(violation)[:NEWTON_STARTS]:
+            st = solve_static(self.model, c, self.omega, q0=qs[k])
+            if st.converged:
+                return st, False
+        if not piecewise_affine or self.base.n_blades > ENUMERATE_MAX_BLADES:
+            return None, False
+        qs, ok, _, regular = self.solve(self.every_set(), g0)
+        if ok.any():
+            return self._polish(c, self._nearest(qs[ok], near)), False
+        return None, regular
+
+    @staticmethod
+    def _nearest(qs: np.ndarray, near: np.ndarray | None) -> np.ndarray:
+        return qs[0] if near is None else qs[int(np.argmin(np.linalg.norm(qs - near, axis=1)))]
+
+    def _polish(self, c: ContactModel, q: np.ndarray) -> StaticResult | None:
+        # the set's solution is exact; Newton from it returns the solver's result and residual
+        st = solve_static(self.model, c, self.omega, q0=q)
+        return st if st.converged else None
 
 
 @lru_cache(maxsize=8)
@@ -38,27 +157,36 @@ def _cached_model(params_json: str) -> Model:
     return build_model(from_dict(json.loads(params_json)))
 
 
-def map_row(params_json: str, formulation: str, variant: str, speed: float, g0s: list[float]) -> dict[str, np.ndarray]:
+def map_row(params_json: str, formulation: str, variant: str, speed: float, g0s: list[float],
+            solver: str = ROW_SOLVER) -> dict[str, np.ndarray]:
     """One speed row of a static/stability map (top-level: runs in any worker)."""
     model = _cached_model(params_json)
     omega = speed * model.params.normalisation.omega_ref
     order = np.argsort(g0s)[::-1]
     n = len(g0s)
-    out = {k: np.zeros(n) for k in ("n_contact", "chord_total", "max_real", "sum_pos", "converged", "residual")}
+    keys = ("n_contact", "chord_total", "max_real", "sum_pos", "converged", "residual", "from_contact_set")
+    out = {k: np.zeros(n) for k in keys}
     base = make_contact(model, formulation, variant)
-    q = None
+    starts: ContactSetStarts | None = None  # built at the row's first failure only
+    q = q_last = None
     for i in order:
         c = base.with_clearance(float(g0s[i]))
         st = solve_static(model, c, omega, q0=q)
-        q = st.q
+        proven_absent = False
+        if not st.converged:
+            starts = starts or ContactSetStarts(model, base, omega)
+            found, proven_absent = starts.find(float(g0s[i]), q_last)
+            if found is not None:
+                st = found
+                out["from_contact_set"][i] = 1.0
+        q = st.q if st.converged else None
         out["converged"][i] = float(st.converged)
         out["residual"][i] = st.residual
         if not st.converged:
-            # no equilibrium found (near folds, or none exists): marked, never counted as contact
-            out["n_contact"][i] = -1
+            out["n_contact"][i] = NO_EQUILIBRIUM if proven_absent else NOT_CONVERGED
             out["max_real"][i] = out["sum_pos"][i] = np.nan
-            q = None
             continue
+        q_last = st.q
         out["n_contact"][i] = st.n_contact
         out["chord_total"][i] = float(np.sum(st.fractions))
         out["max_real"][i], out["sum_pos"][i] = stability_indicators(model, c, omega, st.q)
@@ -70,11 +198,12 @@ class StabilityMap:
     formulation: str
     speeds: np.ndarray  # normalised
     g0s: np.ndarray  # m
-    n_contact: np.ndarray  # (n_speeds, n_g0)
+    n_contact: np.ndarray  # (n_speeds, n_g0); NOT_CONVERGED, NO_EQUILIBRIUM where no solution
     chord_total: np.ndarray
     max_real: np.ndarray
     sum_pos: np.ndarray
     converged: np.ndarray
+    from_contact_set: np.ndarray | None = None  # 1 where a contact-set start found the solution
 
     @property
     def contact(self) -> np.ndarray:
@@ -88,7 +217,17 @@ class StabilityMap:
 
     @property
     def no_solution(self) -> np.ndarray:
+        """Cells without a balanced solution on the map, whatever the reason."""
         return self.n_contact < 0
+
+    @property
+    def not_converged(self) -> np.ndarray:
+        return self.n_contact == NOT_CONVERGED
+
+    @property
+    def no_equilibrium(self) -> np.ndarray:
+        """Cells where no equilibrium exists (proven)."""
+        return self.n_contact == NO_EQUILIBRIUM
 
     def cell_areas(self) -> np.ndarray:
         """Area of each cell in the (speed, g0) plane: fractions are of the contact AREA,
@@ -113,15 +252,26 @@ class StabilityMap:
         nb_free = free[:-2, 1:-1] | free[2:, 1:-1] | free[1:-1, :-2] | free[1:-1, 2:]
         return c & nb_free
 
-    def stable_strip(self) -> bool:
+    def boundary_stable_fraction(self) -> float | None:
+        """Stable share of the contact region's boundary cells, by area like every fraction of the map (the
+        quick grid's clearances are spaced quadratically: a count would weigh the thin cells near g0 = 0
+        as much as the wide ones at the top)."""
         b = self.boundary()
-        if b.sum() == 0 or not (self.unstable & self.contact).any():
+        if not b.any():
+            return None
+        a = self.cell_areas()
+        return float(a[b & ~self.unstable].sum() / a[b].sum())
+
+    def stable_strip(self) -> bool:
+        f = self.boundary_stable_fraction()
+        if f is None or not (self.unstable & self.contact).any():
             return False
-        return bool((~self.unstable[b]).mean() >= 0.8)
+        return bool(f >= STABLE_STRIP_MIN)
 
     def summary(self) -> dict:
         c = self.contact
         b = self.boundary()
+        rescued = 0 if self.from_contact_set is None else int(np.sum(self.from_contact_set > 0))
         return {
             "formulation": self.formulation,
             "unstable_fraction": self.unstable_fraction(),
@@ -129,47 +279,47 @@ class StabilityMap:
             "grid_points": int(c.size),
             "max_blades_in_contact": int(self.n_contact.max()),
             "stable_strip": self.stable_strip(),
-            "boundary_stable_fraction": float((~self.unstable[b]).mean()) if b.any() else None,
-            "no_equilibrium_points": int(self.no_solution.sum()),
+            "boundary_stable_fraction": self.boundary_stable_fraction(),
+            "boundary_cells": int(b.sum()),
+            "boundary_stable_cells": int((~self.unstable[b]).sum()),
+            "no_equilibrium_points": int(self.no_equilibrium.sum()),
+            "not_converged_points": int(self.not_converged.sum()),
+            "found_from_contact_set_points": rescued,
+            "no_solution_note": "no_equilibrium_points: proven (2D: no contact set is consistent with its gaps); "
+                                "not_converged_points: the solver found none, one may exist; "
+                                "found_from_contact_set_points: solved from a contact-set start after the "
+                                "warm start failed (past a fold of the branch continued in g0)",
             "max_sum_positive_real": float(np.nanmax(self.sum_pos)) if np.isfinite(self.sum_pos).any() else 0.0,
         }
 
     def plot(self, path: str | Path) -> Path:
         plt = pyplot()
-        fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharey=True)
-        X, Y = self.speeds, self.g0s * 1e3
-        nmax = max(int(self.n_contact.max()), 1)
-        im0 = axes[0].pcolormesh(X, Y, np.where(self.contact, self.n_contact, np.nan).T, cmap="viridis",
-                                 vmin=0.5, vmax=nmax + 0.5, shading="nearest")
-        fig.colorbar(im0, ax=axes[0], label="blades in contact", ticks=range(1, nmax + 1))
-        axes[1].pcolormesh(X, Y, np.where(self.contact & ~self.unstable, 1.0, np.nan).T, cmap="Greens", vmin=0, vmax=4,
-                           shading="nearest")
-        val = np.where(self.contact & self.unstable, self.sum_pos, np.nan).T
-        im1 = axes[1].pcolormesh(X, Y, val, cmap="inferno_r", shading="nearest")
-        fig.colorbar(im1, ax=axes[1], label="sum of positive real parts [1/s]")
-        for ax in axes:
-            grey = np.where(self.no_solution, 1.0, np.nan).T
-            ax.pcolormesh(X, Y, grey, cmap="Greys", vmin=0, vmax=2, shading="nearest")
-            ax.contour(X, Y, self.contact.T.astype(float), levels=[0.5], colors="k", linewidths=0.8)
-            ax.set_xlabel("normalised spin speed Ω / Ω_ref")
-            ax.grid(alpha=0.2)
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4.8), sharey=True)
+        draw_contact_panel(fig, axes[0], self)
+        draw_stability_panel(fig, axes[1], self)
         axes[0].set_ylabel("initial clearance g0 [mm]")
-        axes[0].set_title(f"{self.formulation}: contact configuration")
-        axes[1].set_title(f"{self.formulation}: stability (green = stable, grey = no equilibrium)")
-        return save_figure(fig, path)
+        axes[0].set_title(f"{self.formulation}: blades in contact")
+        axes[1].set_title(f"{self.formulation}: stability of the static solution")
+        h = category_handles([self])
+        fig.legend(handles=h, loc="lower center", ncol=len(h), fontsize=8, frameon=False, bbox_to_anchor=(0.5, 0.0))
+        fig.tight_layout(rect=(0, 0.07, 1, 1))
+        return save_figure(fig, path, layout=False)
 
     @classmethod
     def load(cls, folder: str | Path, formulation: str) -> StabilityMap:
         """A map written by :meth:`save` (``stability_<formulation>.npz`` in ``folder``)."""
         d = np.load(Path(folder) / f"stability_{formulation}.npz")
+        rescued = d["from_contact_set"] if "from_contact_set" in d.files else None
         return cls(formulation, d["speeds"], d["g0s"], d["n_contact"].astype(int), d["chord_total"], d["max_real"],
-                   d["sum_pos"], d["converged"])
+                   d["sum_pos"], d["converged"], rescued)
 
     def save(self, out: str | Path) -> dict:
         stem = f"stability_{self.formulation}"
         s = save_result(self, out, stem)
+        extra = {} if self.from_contact_set is None else {"from_contact_set": self.from_contact_set}
         np.savez(Path(out) / f"{stem}.npz", speeds=self.speeds, g0s=self.g0s, n_contact=self.n_contact,
-                 chord_total=self.chord_total, max_real=self.max_real, sum_pos=self.sum_pos, converged=self.converged)
+                 chord_total=self.chord_total, max_real=self.max_real, sum_pos=self.sum_pos, converged=self.converged,
+                 **extra)
         return s
 
 
@@ -190,11 +340,87 @@ def run_stability_map(
     pj = json.dumps(to_dict(model.params), sort_keys=True)
     g0l = [float(g) for g in g0s]
     payloads = [
-        {"params_json": pj, "formulation": formulation, "variant": variant, "speed": float(s), "g0s": g0l}
+        {"params_json": pj, "formulation": formulation, "variant": variant, "speed": float(s), "g0s": g0l,
+         "solver": ROW_SOLVER}
         for s in speeds
     ]
     rows = run_tasks(map_row, payloads, executor=executor, out=out, progress=progress,
                      desc=f"{formulation} static+stability map")
     stack = {k: np.array([r[k] for r in rows]) for k in rows[0]}
     return StabilityMap(formulation, np.asarray(speeds, float), np.asarray(g0s, float), stack["n_contact"].astype(int),
-                        stack["chord_total"], stack["max_real"], stack["sum_pos"], stack["converged"])
+                        stack["chord_total"], stack["max_real"], stack["sum_pos"], stack["converged"],
+                        stack.get("from_contact_set"))
+
+
+# ----------------------------------------------------------------------------- figures
+# Stable cells get one flat colour and the unstable ones a sequential scale that starts well away from
+# it (blue against yellow-red, told apart in every common colour vision deficiency too); the scale is
+# logarithmic because the sum of positive real parts spans 1e-6 to 10 /s on one map.
+STABLE_COLOUR = "#2166ac"
+NOT_CONVERGED_COLOUR = "#9a9a9a"
+NO_EQUILIBRIUM_COLOUR = "#000000"
+
+
+def unstable_cmap():
+    from matplotlib.colors import ListedColormap
+
+    return ListedColormap(pyplot().get_cmap("YlOrRd")(np.linspace(0.3, 1.0, 256)), name="unstable")
+
+
+def _cells(ax, m: StabilityMap, mask: np.ndarray, colour: str, zorder: float) -> None:
+    from matplotlib.colors import ListedColormap
+
+    ax.pcolormesh(m.speeds, m.g0s * 1e3, np.where(mask, 1.0, np.nan).T, cmap=ListedColormap([colour]),
+                  shading="nearest", zorder=zorder)
+
+
+def _finish(ax, m: StabilityMap) -> None:
+    ax.contour(m.speeds, m.g0s * 1e3, m.contact.T.astype(float), levels=[0.5], colors="k", linewidths=0.8,
+               zorder=4)
+    _cells(ax, m, m.not_converged, NOT_CONVERGED_COLOUR, 3)
+    _cells(ax, m, m.no_equilibrium, NO_EQUILIBRIUM_COLOUR, 3)
+    ax.set_xlabel("normalised spin speed Ω / Ω_ref [-]")
+    ax.grid(alpha=0.2)
+
+
+def draw_contact_panel(fig, ax, m: StabilityMap, cax=None) -> None:
+    """Blades in contact: one colour per count (a discrete scale, its colourbar ticked per count)."""
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+
+    nmax = max(int(m.n_contact.max()), 1)
+    cmap = ListedColormap(pyplot().get_cmap("viridis")(np.linspace(0.0, 1.0, nmax)))
+    norm = BoundaryNorm(np.arange(0.5, nmax + 1.0), nmax)
+    im = ax.pcolormesh(m.speeds, m.g0s * 1e3, np.where(m.contact, m.n_contact, np.nan).T, cmap=cmap, norm=norm,
+                       shading="nearest")
+    fig.colorbar(im, ax=ax, cax=cax, label="blades in contact [-]", ticks=range(1, nmax + 1))
+    _finish(ax, m)
+
+
+def draw_stability_panel(fig, ax, m: StabilityMap, cax=None) -> None:
+    """Stable contact cells flat blue; unstable ones coloured by the sum of positive real parts (log scale)."""
+    from matplotlib.colors import LogNorm
+
+    _cells(ax, m, m.contact & ~m.unstable, STABLE_COLOUR, 1)
+    val = np.where(m.contact & m.unstable, m.sum_pos, np.nan)
+    pos = val[np.isfinite(val) & (val > 0)]
+    lo, hi = (float(pos.min()), float(pos.max())) if pos.size else (1e-6, 1.0)
+    im = ax.pcolormesh(m.speeds, m.g0s * 1e3, val.T, cmap=unstable_cmap(), shading="nearest", zorder=2,
+                       norm=LogNorm(vmin=lo, vmax=max(hi, lo * 10)))
+    fig.colorbar(im, ax=ax, cax=cax, label="unstable: Σ Re(λ) > 0 [1/s]")
+    _finish(ax, m)
+
+
+def category_handles(maps: list[StabilityMap]) -> list:
+    """Legend entries of the flat colours (the colour scales have their colourbars); a category that no
+    map has is left out, so the legend says nothing the figures do not show."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    h = [Patch(facecolor=STABLE_COLOUR, label="stable contact (every Re(λ) ≤ 0)"),
+         Line2D([], [], color="k", lw=0.8, label="edge of the contact region")]
+    if any(m.not_converged.any() for m in maps):
+        h.append(Patch(facecolor=NOT_CONVERGED_COLOUR, label="solver did not converge (an equilibrium may exist)"))
+    if any(m.no_equilibrium.any() for m in maps):
+        h.append(Patch(facecolor=NO_EQUILIBRIUM_COLOUR, label="no equilibrium (none of the 2^N contact sets)"))
+    h.append(Patch(facecolor="white", edgecolor="0.6", label="no contact"))
+    return h

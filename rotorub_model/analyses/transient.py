@@ -316,20 +316,19 @@ class TransientResult:
         }
 
     def plot(self, path: str | Path, title: str = "") -> Path:
+        from ..results import legend_outside, plot_blade_forces
+
         plt = pyplot()
-        fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
-        FN = self.outputs["F_N"]
-        for j in range(FN.shape[1]):
-            if FN[:, j].max() > 0:
-                axes[0].plot(self.t, FN[:, j], lw=1, label=f"blade {j + 1}")
+        fig, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+        plot_blade_forces(axes[0], self.t, self.outputs["F_N"])
         axes[0].set_ylabel("normal contact force F_N [N]")
-        axes[0].legend(fontsize=7, ncol=2)
         axes[0].set_title(title or f"{self.formulation} transient" + (" (diverged)" if self.diverged else ""))
-        axes[1].plot(self.t, np.hypot(*self.outputs["disk_fixed"].T) * 1e3, lw=1)
+        axes[1].plot(self.t, np.hypot(*self.outputs["disk_fixed"].T) * 1e3, lw=1, color="0.2")
         axes[1].set_ylabel("fan-disk displacement [mm]")
         axes[1].set_xlabel("time [s]")
         for ax in axes:
             ax.grid(alpha=0.3)
+            legend_outside(ax)
         return save_figure(fig, path)
 
     def save(self, out: str | Path, stem: str | None = None) -> dict:

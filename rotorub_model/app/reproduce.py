@@ -7,6 +7,8 @@ they hold.
 
 from __future__ import annotations
 
+import hashlib
+import json
 from pathlib import Path
 
 from ..results import write_json
@@ -27,17 +29,39 @@ def fact1(resp: dict) -> dict:
 
 
 def fact5(stab: dict) -> dict:
+    from ..analyses.maps import STABLE_STRIP_MIN
+
     u2, u3 = stab["unstable_fraction_2d"], stab["unstable_fraction_3d"]
-    return {
+    b3 = stab["map_3d"]["boundary_stable_fraction"]
+    f = {
         "id": 5,
         "statement": "static solutions: 2D unstable over almost the whole contact area; 3D a smaller unstable "
                      "fraction with a stable strip around the unstable area",
         "paper": {"unstable_fraction_2d": "almost all", "unstable_fraction_3d": "smaller", "stable_strip_3d": True},
         "ours": {"unstable_fraction_2d": u2, "unstable_fraction_3d": u3, "stable_strip_3d": stab["stable_strip_3d"],
-                 "boundary_stable_fraction_3d": stab["map_3d"]["boundary_stable_fraction"],
+                 "boundary_stable_fraction_3d": b3,
+                 "boundary_stable_cells_3d": stab["map_3d"].get("boundary_stable_cells"),
+                 "boundary_cells_3d": stab["map_3d"].get("boundary_cells"),
                  "max_blades_in_contact": [stab["max_blades_in_contact_2d"], stab["max_blades_in_contact_3d"]]},
         "holds": bool(u2 >= 0.8 and u3 < u2 and stab["stable_strip_3d"]),
     }
+    if not f["holds"]:
+        why = []
+        if u2 < 0.8:
+            why.append(f"the 2D solutions are unstable over {u2:.0%} of the contact area (almost all: >= 80 %)")
+        if u3 >= u2:
+            why.append(f"the 3D unstable fraction ({u3:.0%}) is not below the 2D one ({u2:.0%})")
+        if not stab["stable_strip_3d"]:
+            m3 = stab["map_3d"]
+            if b3 is None:
+                why.append("the 3D map has no contact region with a free neighbour: no boundary to be stable")
+            else:
+                why.append(f"{b3:.1%} of the 3D contact region's boundary is stable, by area ("
+                           f"{m3.get('boundary_stable_cells', '?')} of its {m3.get('boundary_cells', '?')} boundary "
+                           f"cells); a stable strip needs {STABLE_STRIP_MIN:.0%} (stability/stability_maps.png shows "
+                           "where the boundary is unstable)")
+        f["why"] = "; ".join(why)
+    return f
 
 
 def fact6(tr: dict) -> list[dict]:
@@ -61,9 +85,11 @@ def fact6(tr: dict) -> list[dict]:
         "holds": bool(f["3D"] > f["2D"]),
     }
     if not a["holds"]:
-        a["why"] = ("at the chosen point the transients do not show it: " + ", ".join(
-            f"{k} = {v}" for k, v in a["ours"].items()) + " (the automatic point choice and the calibration of the "
-            "casing/contact parameters set this; see docs/THEORY.md section 6)")
+        from .report import describe_ours
+
+        a["why"] = ("at the chosen point the transients do not show it: " + describe_ours(a) + " (the automatic "
+                    "point choice and the calibration of the casing/contact parameters set this; see docs/THEORY.md "
+                    "section 6)")
     if not b["holds"]:
         b["why"] = (f"the 3D force at 1 s is {f['3D']:.1f} N against {f['2D']:.1f} N in 2D; the 3D stability "
                     "at this point comes from the partly touching chord, not from a larger force. Friction "
@@ -73,13 +99,67 @@ def fact6(tr: dict) -> list[dict]:
     return [a, b]
 
 
-def run_reproduce(model: Model, out: str | Path, quick: bool = False) -> dict:
+def parameter_source(model: Model, params_file: str | Path | None = None) -> dict:
+    """What the run was computed from: the parameter file and the sha256 of its bytes, or the embedded
+    reference and the sha256 of its TOML; and, either way, the sha256 of the parameter values themselves
+    (canonical JSON: two files differing in comments only give the same one)."""
+    from ..structure.params import REFERENCE_FILE, load_parameters, reference_parameters, to_dict
+
+    values = hashlib.sha256(json.dumps(to_dict(model.params), sort_keys=True).encode()).hexdigest()
+    if params_file is not None:
+        path = Path(params_file)
+        return {"source": str(path), "absolute_path": str(path.resolve()),
+                "sha256": hashlib.sha256(path.read_bytes()).hexdigest(), "sha256_of": "the file",
+                "values_sha256": values, "file_matches_model": load_parameters(path) == model.params}
+    if model.params == reference_parameters():
+        return {"source": "embedded reference", "absolute_path": str(REFERENCE_FILE),
+                "sha256": hashlib.sha256(REFERENCE_FILE.read_bytes()).hexdigest(),
+                "sha256_of": "the embedded reference TOML, rotorub_model/data/reference.toml", "values_sha256": values}
+    # parameters built in memory (or a file whose path the caller did not pass): only the values identify them
+    return {"source": "parameters given in memory (no file path passed)", "absolute_path": None, "sha256": values,
+            "sha256_of": "the canonical JSON of the parameter values", "values_sha256": values}
+
+
+def run_inputs(model: Model, params_file: str | Path | None, quick: bool, det: dict, stab: dict,
+               sizes: dict) -> dict:
+    """The inputs record of the summary and the report: parameters, grids, package version."""
+    import numpy
+    import scipy
+
+    from .. import __version__
+
+    g = stab["grid"]
+    return {
+        "parameters": parameter_source(model, params_file),
+        "grid": {
+            "mode": "quick" if quick else "full",
+            "response_speeds": sizes["response"],
+            "campbell_speeds": sizes["campbell"],
+            "detection": {"n_speeds": det["n_speeds"], "speed_range": det["speed_range"], "n_g0": det["n_g0"],
+                          "g0_range_mm": det["g0_range_mm"]},
+            "stability_maps": {"n_speeds": g["speeds"][2], "speed_range": g["speeds"][:2], "n_g0": g["g0_mm"][2],
+                               "g0_range_mm": g["g0_mm"][:2],
+                               "g0_spacing": "quadratic (denser at small g0)" if quick else "uniform"},
+            "blade_discretisation_speeds": sizes["discretisation"],
+            "transient_t_end_s": sizes["transient_t_end_s"],
+            "continuation": "quick (fewer orbits per branch)" if quick else "full",
+        },
+        "package_version": __version__,
+        "library_versions": {"numpy": numpy.__version__, "scipy": scipy.__version__},
+    }
+
+
+def run_reproduce(model: Model, out: str | Path, quick: bool = False, params_file: str | Path | None = None) -> dict:
+    """Every analysis of the paper on ``model``; ``params_file``: the file it was loaded from (recorded with
+    its hash in the summary and the report; None: the embedded reference, or parameters built in memory)."""
     from ..analyses.linear import run_campbell, run_modes, run_response
 
     out = Path(out)
-    resp = run_response(model, n_speeds=600 if quick else 2000).save(out / "response")
+    sizes = {"response": 600 if quick else 2000, "campbell": 25 if quick else 80,
+             "discretisation": 13 if quick else 41, "transient_t_end_s": 20.0}
+    resp = run_response(model, n_speeds=sizes["response"]).save(out / "response")
     run_modes(model, resp["critical_speeds"][0]).save(out / "modes")
-    run_campbell(model, n_speeds=25 if quick else 80).save(out / "campbell")
+    run_campbell(model, n_speeds=sizes["campbell"]).save(out / "campbell")
     from ..analyses.detection import paper_facts as detection_facts
     from ..analyses.detection import run_detection
 
@@ -87,15 +167,16 @@ def run_reproduce(model: Model, out: str | Path, quick: bool = False) -> dict:
     from ..analyses.discretisation import run_blade_convergence
     from .studies import run_stability_study, run_transient_study
 
-    disc = run_blade_convergence(model.params, n_speeds=13 if quick else 41)
+    disc = run_blade_convergence(model.params, n_speeds=sizes["discretisation"])
     disc_summary = disc.save(out / "discretisation")
     disc_summary["table_markdown"] = disc.table_markdown()
     stab = run_stability_study(model, out / "stability", quick=quick)
-    tr = run_transient_study(model, out / "transient", stab_dir=out / "stability")
+    tr = run_transient_study(model, out / "transient", stab_dir=out / "stability", t_end=sizes["transient_t_end_s"])
     from .studies import run_continuation_study
 
     cont = run_continuation_study(model, out / "continuation", maps_dir=out / "stability", quick=quick)
     summary = {
+        "inputs": run_inputs(model, params_file, quick, det, stab, sizes),
         "n_dofs": model.n_dofs,
         "omega_ref_rad_s": model.params.normalisation.omega_ref,
         "response": resp,

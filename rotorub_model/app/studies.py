@@ -66,6 +66,10 @@ def run_stability_study(model: Model, out: str | Path, quick: bool = False, spee
         "max_blades_in_contact_3d": s3["max_blades_in_contact"],
         "no_equilibrium_points_2d": s2["no_equilibrium_points"],
         "no_equilibrium_points_3d": s3["no_equilibrium_points"],
+        "not_converged_points_2d": s2["not_converged_points"],
+        "not_converged_points_3d": s3["not_converged_points"],
+        "found_from_contact_set_points_2d": s2["found_from_contact_set_points"],
+        "found_from_contact_set_points_3d": s3["found_from_contact_set_points"],
         "grid": {"speeds": [float(speeds[0]), float(speeds[-1]), len(speeds)],
                  "g0_mm": [float(g0s[0] * 1e3), float(g0s[-1] * 1e3), len(g0s)]},
         "map_2d": s2,
@@ -76,29 +80,24 @@ def run_stability_study(model: Model, out: str | Path, quick: bool = False, spee
 
 
 def _plot_pair(maps: dict[str, StabilityMap], path: Path) -> None:
+    """2D over 3D: blades in contact (left) and stability (right), the flat colours' legend below."""
+    from ..analyses.maps import category_handles, draw_contact_panel, draw_stability_panel
+
     plt = pyplot()
-    fig, axes = plt.subplots(2, 2, figsize=(11, 8), sharex=True, sharey=True)
+    fig, axes = plt.subplots(2, 2, figsize=(11, 8.6), sharex=True, sharey=True)
     for row, f in enumerate(("2D", "3D")):
-        m = maps[f]
-        X, Y = m.speeds, m.g0s * 1e3
-        nmax = max(int(m.n_contact.max()), 1)
-        a = axes[row, 0].pcolormesh(X, Y, np.where(m.contact, m.n_contact, np.nan).T, cmap="viridis",
-                                    vmin=0.5, vmax=nmax + 0.5, shading="nearest")
-        fig.colorbar(a, ax=axes[row, 0], label="blades in contact")
-        stable_cells = np.where(m.contact & ~m.unstable, 1.0, np.nan).T
-        axes[row, 1].pcolormesh(X, Y, stable_cells, cmap="Greens", vmin=0, vmax=4, shading="nearest")
-        b = axes[row, 1].pcolormesh(X, Y, np.where(m.contact & m.unstable, m.sum_pos, np.nan).T, cmap="inferno_r",
-                                    shading="nearest")
-        fig.colorbar(b, ax=axes[row, 1], label="Σ Re(λ) > 0 [1/s]")
+        draw_contact_panel(fig, axes[row, 0], maps[f])
+        draw_stability_panel(fig, axes[row, 1], maps[f])
+        axes[row, 0].set_ylabel(f"{f}: initial clearance g0 [mm]")
         for ax in axes[row]:
-            ax.pcolormesh(X, Y, np.where(m.no_solution, 1.0, np.nan).T, cmap="Greys", vmin=0, vmax=2, shading="nearest")
-            ax.contour(X, Y, m.contact.T.astype(float), levels=[0.5], colors="k", linewidths=0.8)
-        axes[row, 0].set_ylabel(f"{f}: g0 [mm]")
-    axes[0, 0].set_title("contact configuration (blades in contact)")
-    axes[0, 1].set_title("stability: Σ positive real parts (green = stable contact, grey = no equilibrium)")
-    for ax in axes[1]:
-        ax.set_xlabel("normalised spin speed Ω / Ω_ref")
-    save_figure(fig, path, dpi=110)
+            ax.set_xlabel("normalised spin speed Ω / Ω_ref [-]" if row == 1 else "")
+    axes[0, 0].set_title("blades in contact")
+    axes[0, 1].set_title("stability of the static solution")
+    h = category_handles(list(maps.values()))
+    fig.legend(handles=h, loc="lower center", ncol=min(len(h), 3), fontsize=8.5, frameon=False,
+               bbox_to_anchor=(0.5, 0.0))
+    fig.tight_layout(rect=(0, 0.06, 1, 1))
+    save_figure(fig, path, dpi=110, layout=False)
 
 
 def point_status(model: Model, speed: float, g0: float) -> dict:
@@ -268,22 +267,31 @@ class TransientStudy:
         }
 
     def plot(self, path: str | Path) -> Path:
+        """2D and 3D forces side by side (each on its own scale: a diverging 2D run would flatten the 3D one);
+        a blade keeps its colour in both panels and the one legend sits right of them, outside the data."""
+        from ..results import plot_blade_forces
+
         plt = pyplot()
-        fig, axes = plt.subplots(1, 2, figsize=(12, 4.2), sharey=False)
+        fig, axes = plt.subplots(1, 2, figsize=(12, 4.2))
         for ax, f in zip(axes, ("2D", "3D")):
             r = self.runs[f]
-            FN = r.outputs["F_N"]
-            for j in range(FN.shape[1]):
-                if FN[:, j].max() > 0:
-                    ax.plot(r.t, FN[:, j], lw=1, label=f"blade {j + 1}")
-            ax.axvline(1.0, color="k", lw=0.6, ls=":")
+            plot_blade_forces(ax, r.t, r.outputs["F_N"])
+            ax.axvline(1.0, color="k", lw=0.6, ls=":", label="end of the imbalance ramp (1 s)")
             ax.set_title(f"{f}: normal contact forces" + (" — diverged" if r.diverged else ""))
             ax.set_xlabel("time [s]")
-            ax.set_ylabel("F_N [N]")
+            ax.set_ylabel("normal contact force F_N [N]")
             ax.grid(alpha=0.3)
-            ax.legend(fontsize=7)
-        fig.suptitle(f"Ω = {self.speed:.3g}, g0 = {self.g0 * 1e3:.3g} mm (imbalance ramp over 1 s)")
-        return save_figure(fig, path)
+        seen: dict[str, object] = {}
+        for ax in axes:
+            for h, lab in zip(*ax.get_legend_handles_labels()):
+                seen.setdefault(lab, h)
+        labels = sorted(seen, key=lambda s: (not s.startswith("blade"), int(s.split()[1]) if s.startswith("blade")
+                                             else 0))
+        fig.legend([seen[k] for k in labels], labels, loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize=8,
+                   frameon=False)
+        fig.suptitle(f"Ω = {self.speed:.3g} Ω_ref, g0 = {self.g0 * 1e3:.3g} mm (imbalance ramped in over 1 s)")
+        fig.tight_layout()
+        return save_figure(fig, path, layout=False)
 
     def save(self, out: str | Path) -> dict:
         out = Path(out)

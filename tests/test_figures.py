@@ -1,0 +1,211 @@
+"""What the figures show (issue 18, points 5 and 7): 3D drawn over 2D, sweep curves told apart, stable vs
+unstable cells by colour with a scale, legends outside the data; and what the stability maps call a cell
+without a solution (solved from a contact-set start, proven absent, or the solver's failure)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from matplotlib.colors import to_rgb
+
+from rotorub_model.analyses import discretisation, maps, transient
+from rotorub_model.analyses.detection import run_detection
+from rotorub_model.analyses.maps import NO_EQUILIBRIUM, NOT_CONVERGED, ContactSetStarts, run_stability_map
+from rotorub_model.analyses.transient import run_transient
+from rotorub_model.app import studies
+from rotorub_model.app.studies import default_grid
+from rotorub_model.contact import make_contact
+from rotorub_model.results import pyplot
+from rotorub_model.structure.model import build_model
+from rotorub_model.structure.params import reference_parameters
+
+
+@pytest.fixture(scope="module")
+def det(ref_model):
+    return run_detection(ref_model, n_speeds=80, n_g0=30, progress=False)
+
+
+@pytest.fixture
+def captured(monkeypatch):
+    """Figures handed to save_figure by the plot methods, laid out and drawn, kept open for inspection."""
+    figs = []
+
+    def keep(fig, path, dpi: int = 120, layout: bool = True) -> Path:
+        if layout:
+            fig.tight_layout()
+        fig.canvas.draw()
+        figs.append(fig)
+        return Path(path)
+
+    for mod in (transient, studies, discretisation, maps):
+        monkeypatch.setattr(mod, "save_figure", keep)
+    yield figs
+    for f in figs:
+        pyplot().close(f)
+
+
+def _legends(fig) -> list:
+    return [*fig.legends, *(a.get_legend() for a in fig.axes if a.get_legend() is not None)]
+
+
+def assert_legends_hide_nothing(fig) -> None:
+    """Every legend lies outside every data axes (colourbars aside): it cannot cover a curve or a cell."""
+    fig.canvas.draw()
+    r = fig.canvas.get_renderer()
+    data_axes = [a for a in fig.axes if a.get_label() != "<colorbar>"]
+    assert _legends(fig), "no legend at all"
+    for leg in _legends(fig):
+        box = leg.get_window_extent(r)
+        for ax in data_axes:
+            assert not box.overlaps(ax.get_window_extent(r)), (leg.get_texts()[0].get_text(), ax.get_title())
+
+
+# ----------------------------------------------------------------------------- point 1, 2: detection
+
+
+def test_detection_draws_3d_above_2d_and_lets_2d_show_through(det):
+    fig = det.figure("2d_3d")
+    try:
+        for ax in fig.axes:
+            z = {k: [a.get_zorder() for a in ax.get_children() if a.get_gid() == k] for k in ("2D", "3D")}
+            assert len(z["2D"]) == len(z["3D"]) == 2, z  # fill and closure line each
+            assert min(z["3D"]) > max(z["2D"]), z
+            fill_3d = next(a for a in ax.collections if a.get_gid() == "3D")
+            assert fill_3d.get_hatch() and not np.any(fill_3d.get_facecolor()[:, 3] > 0)  # a hatch, no face
+        assert_legends_hide_nothing(fig)
+    finally:
+        pyplot().close(fig)
+
+
+@pytest.mark.parametrize("study", ["theta", "chord"])
+def test_sweep_curves_differ_in_colour_style_and_marker(det, study):
+    fig = det.figure(study)
+    try:
+        for ax in fig.axes:
+            lines = [ln for ln in ax.get_lines() if len(ln.get_xdata()) > 2]
+            looks = {(to_rgb(ln.get_color()), str(ln.get_linestyle()), ln.get_marker()) for ln in lines}
+            assert len(lines) >= 5 and len(looks) == len(lines)
+            colours = [np.array(to_rgb(ln.get_color())) for ln in lines]
+            gaps = [np.linalg.norm(a - b) for i, a in enumerate(colours) for b in colours[i + 1:]]
+            assert min(gaps) > 0.15, min(gaps)
+            assert ax.get_xlabel().endswith("[-]") and "[mm]" in ax.get_ylabel()
+        assert_legends_hide_nothing(fig)
+    finally:
+        pyplot().close(fig)
+
+
+# ----------------------------------------------------------------------------- point 4: cells without a solution
+
+
+@pytest.fixture(scope="module")
+def stiff():
+    """A ten times stiffer contact: the quick map's flank past the first critical, where the branch continued in
+    g0 folds (measured before the contact-set starts: 62 2D and 66 3D cells "no equilibrium")."""
+    m = build_model(reference_parameters().replace(contact={"k_r": 1.5e7}))
+    speeds, g0s = default_grid(m, quick=True)
+    return m, speeds, g0s
+
+
+@pytest.mark.parametrize("formulation", ["2D", "3D"])
+def test_stiff_flank_cells_are_solved_from_contact_sets(stiff, formulation, monkeypatch):
+    m, speeds, g0s = stiff
+    speeds = speeds[[20, 22, 27]]  # 3.51, 3.59, 3.80: 24 of those cells
+    mp = run_stability_map(m, formulation, speeds, g0s, executor="serial", progress=False)
+    s = mp.summary()
+    assert s["no_equilibrium_points"] == 0 and s["not_converged_points"] == 0
+    assert s["found_from_contact_set_points"] >= 3
+    assert mp.converged.all() and np.isfinite(mp.max_real).all()
+    # without the contact-set starts the same cells fail, and are counted as the solver's failures, not as a
+    # proven absence
+    monkeypatch.setattr(ContactSetStarts, "find", lambda self, g0, near: (None, False))
+    bare = run_stability_map(m, formulation, speeds, g0s, executor="serial", progress=False).summary()
+    assert bare["not_converged_points"] >= 8 and bare["no_equilibrium_points"] == 0
+
+
+def test_a_contact_set_solution_is_an_equilibrium(stiff):
+    """The affine law of a contact set, built from the kernel's law blade by blade, is the kernel's law: a set
+    consistent with its gaps solves the full residual (what makes the 2D enumeration a proof)."""
+    m, speeds, _ = stiff
+    omega = float(speeds[22]) * m.params.normalisation.omega_ref
+    base = make_contact(m, "2D")
+    cs = ContactSetStarts(m, base, omega)
+    g0 = 1.3e-3
+    qs, ok, viol, regular = cs.solve(cs.every_set(), g0)
+    assert regular and ok.sum() >= 1 and np.all(viol[ok] == 0.0)
+    c = base.with_clearance(g0)
+    for q in qs[ok]:
+        r = m.K_omega(omega) @ q - c.forces(q, omega) - m.force(omega)
+        assert np.linalg.norm(r) <= 1e-10 * np.linalg.norm(m.force(omega))
+
+
+def test_proven_absence_and_failure_are_told_apart(stiff, monkeypatch, captured):
+    """Bookkeeping of the two kinds: a 2D cell whose every contact set is inconsistent is NO_EQUILIBRIUM, a 3D
+    one the solver could not solve NOT_CONVERGED; the summary counts each, the figure's legend names each."""
+    m, speeds, g0s = stiff
+    monkeypatch.setattr(maps, "solve_static", _failing_at(maps.solve_static, g0s[20]))
+    monkeypatch.setattr(ContactSetStarts, "find", lambda self, g0, near: (None, self.base.formulation == "2D"))
+    # at the lowest speed every cell converges by itself: only the one made to fail has no solution
+    got = {f: run_stability_map(m, f, speeds[:2], g0s, executor="serial", progress=False) for f in ("2D", "3D")}
+    assert got["2D"].n_contact[0, 20] == NO_EQUILIBRIUM and got["3D"].n_contact[0, 20] == NOT_CONVERGED
+    s2, s3 = got["2D"].summary(), got["3D"].summary()
+    assert (s2["no_equilibrium_points"], s2["not_converged_points"]) == (2, 0)
+    assert (s3["no_equilibrium_points"], s3["not_converged_points"]) == (0, 2)
+    studies._plot_pair(got, Path("unused.png"))
+    labels = [t.get_text() for t in captured[-1].legends[0].get_texts()]
+    assert any(lab.startswith("no equilibrium") for lab in labels)
+    assert any(lab.startswith("solver did not converge") for lab in labels)
+
+
+def _failing_at(solve, g0_bad: float):
+    def solve_static(model, contact, omega, **kw):
+        st = solve(model, contact, omega, **kw)
+        if contact.g0 == g0_bad:
+            st.converged = False
+        return st
+
+    return solve_static
+
+
+# ----------------------------------------------------------------------------- point 3: stability colours
+
+
+def test_stable_and_unstable_cells_cannot_be_confused(stiff, captured):
+    m, speeds, g0s = stiff
+    mp = run_stability_map(m, "3D", speeds[[20, 22, 27]], g0s, executor="serial", progress=False)
+    assert mp.unstable.any() and (mp.contact & ~mp.unstable).any()
+    mp.plot(Path("unused.png"))
+    fig = captured[-1]
+    stable = np.array(to_rgb(maps.STABLE_COLOUR))
+    scale = maps.unstable_cmap()(np.linspace(0.0, 1.0, 256))[:, :3]
+    assert np.min(np.linalg.norm(scale - stable, axis=1)) > 0.5  # not one shade of the scale is near it
+    bars = [a for a in fig.axes if a.get_label() == "<colorbar>"]
+    assert len(bars) == 2
+    assert any("[1/s]" in b.get_ylabel() for b in bars) and any("blades in contact" in b.get_ylabel() for b in bars)
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert any(lab.startswith("stable") for lab in labels)
+    assert_legends_hide_nothing(fig)
+
+
+# ----------------------------------------------------------------------------- point 5: legends
+
+
+def test_transient_legends_are_outside_the_data(ref_model, captured):
+    runs = {f: run_transient(ref_model, make_contact(ref_model, f, g0=0.2e-3), 3.3 * 53.4, t_end=1.2)
+            for f in ("2D", "3D")}
+    runs["2D"].plot(Path("unused.png"))
+    studies.TransientStudy(3.3, 0.2e-3, runs, {}).plot(Path("unused.png"))
+    assert len(captured) == 2
+    for fig in captured:
+        assert_legends_hide_nothing(fig)
+        for ax in fig.axes:
+            assert ax.get_xlabel() in ("", "time [s]") and "[" in ax.get_ylabel()
+    blades = [t.get_text() for t in captured[1].legends[0].get_texts() if t.get_text().startswith("blade")]
+    assert len(blades) == len(set(blades)) >= 2  # one legend for both panels, each blade once
+
+
+def test_discretisation_legends_are_outside_the_data(captured):
+    res = discretisation.run_blade_convergence(reference_parameters(), n_values=(2, 3), n_speeds=3)
+    res.plot(Path("unused.png"))
+    assert_legends_hide_nothing(captured[-1])
