@@ -16,7 +16,9 @@ Two-parameter continuation in coordinates scaled by the map's cell size: a curve
 unit normal n (pointing to the unstable side) and tangent tau is continued by the predictor
 C = P + h tau, and the corrector finds the curve on the normal line through C. Step h: at most
 ``resolution`` cells (a tenth of a cell by default), halved where the corrector fails; at a corner
-(a Hopf curve meeting a switch or fold curve) the tracer looks round the last point on a ring.
+(a Hopf curve meeting a switch or fold curve) the tracer looks round the last point on a ring: ahead
+first, then its back (a stable wedge sharper than 30 degrees), then, in 2D, the far side of a sliver
+(two blades' event lines meeting at a fraction of a degree).
 Balanced solutions are continued from the nearest curve point, so the tracker stays on the branch
 the maps follow (descending g0).
 
@@ -31,9 +33,11 @@ branch's end by bisection); it starts every curve and takes over at corners. A H
 point costs the fast corrector three to five balanced solutions, a fold point about ten; the
 bracketing one takes ten to thirty.
 
-Where the leading mode or branch changes: a seed's stable side is checked by its whole spectrum
-(another mode may have crossed first), every tenth point's too, and in 3D every point's stable
-side must lie on the sheet of balanced solutions the curve was seeded on (same sign(det dR/dq)).
+Where the leading mode or branch changes: a bracket is narrowed until its two ends lead with one
+mode (regula falsi on a mode followed from one end converged on a jump between modes), a seed's
+stable side is checked by its whole spectrum (another mode may have crossed first), every tenth
+point's too, and in 3D every point's stable side must lie on the sheet of balanced solutions the
+curve was seeded on (same sign(det dR/dq)).
 
 Seeds: the verdicts on a 17 x 17 lattice (each speed swept from the largest clearance down, as
 the grid maps are); every lattice edge from a stable end to an unstable one (or to none: no
@@ -43,6 +47,7 @@ it leaves the range, closes, or stops.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -240,6 +245,10 @@ class BoundaryTracer:
             return self._fold(a, b, sa, sb, jump, depth, verify)
 
         if sa.contact_set == sb.contact_set or self.continuous:
+            narrowed = self._one_mode(a, b, sa, sb)
+            if narrowed is None:
+                return None
+            a, b, sa, sb = narrowed
             state = {"s": sb}
 
             def re(t):
@@ -289,6 +298,31 @@ class BoundaryTracer:
         if left.unstable:  # the crossing is before the event
             return self.locate(a, pa, sa, left, depth + 1, verify)
         return self.locate(pb, b, right, sb, depth + 1, verify)
+
+    def _one_mode(self, a: np.ndarray, b: np.ndarray, sa: Sample,
+                  sb: Sample) -> tuple[np.ndarray, np.ndarray, Sample, Sample] | None:
+        """The bracket (a, b, sa, sb) narrowed by bisection on the verdict (whole spectra) until the unstable
+        end's critical eigenvalue, followed to the stable end by Newton, is the stable end's: then one mode
+        crosses between them and regula falsi on its real part has a root to converge on. Across a lattice
+        edge or a corner the two ends' critical modes may differ (friction 0.3, 3D: the disk mode at
+        237 rad/s leads above the first contact, a contact mode at 298 rad/s below), and regula falsi on a
+        mode followed from one end then converged on the jump between modes, a false Hopf point. None
+        where the bracket closes to 1e-7 cells without one mode (a jump of the spectrum)."""
+        for _ in range(30):
+            mu, _ = self.eq.refine(sa.q, sa.omega, sa.g0, sb.mu)
+            if abs(mu - sa.mu) <= 1e-6 * abs(sa.mu):
+                return a, b, sa, sb
+            if float(np.linalg.norm(b - a)) < 1e-7:
+                return None
+            m = 0.5 * (a + b)
+            sm = self.sample(m, sa.q)  # the whole spectrum
+            if sm is None:
+                return None
+            if sm.unstable:
+                b, sb = m, sm
+            else:
+                a, sa = m, sm
+        return None
 
     # ------------------------------------------------------------------ the fast corrector
     # Along a curve the kind of boundary and (for an event) the contact point are known from the
@@ -532,6 +566,7 @@ class BoundaryTracer:
             tau = direction * np.array([-n[1], n[0]])
             h = self.h_max
             closed = False
+            since = 0
             while len(pts) < max_points:
                 c = p + h * tau
                 if not self.inside(c):
@@ -551,7 +586,7 @@ class BoundaryTracer:
                     if h >= 0.05 * self.h_max:
                         continue
                     # a corner (a Hopf curve meeting a fold or switch curve): look round the point
-                    got = self._corner(p, tau, ref)
+                    got = self._corner(p, tau, n, ref, np.array([x[0] for x in pts[-20:]]))
                     if got is None:
                         break
                     h = self.h_max
@@ -573,12 +608,16 @@ class BoundaryTracer:
                 away = pn - self._xy(ra)
                 if (n_new @ away < 0) if np.linalg.norm(away) > 1e-9 else (n_new @ n < 0):
                     n_new = -n_new
+                if t_new @ tau < -0.5 and ra.event is not None and ref[0].event not in (None, ra.event):
+                    # a hairpin round the tip of a 2D stable sliver onto another blade's event line: it runs
+                    # back alongside the line just traced, which is not going round in circles
+                    since = len(pts)
                 pts.append((pn, kind, smp, n_new))
                 p, n, tau, ref = pn, n_new, t_new, (ra, rb)
                 if len(pts) > 20 and direction > 0 and np.linalg.norm(p - p0) < 0.5 * self.h_max:
                     closed = True
                     break
-                recent = np.array([x[0] for x in pts[-40:-3]])
+                recent = np.array([x[0] for x in pts[max(len(pts) - 40, since):-3]])
                 if len(recent) and np.min(np.linalg.norm(recent - p, axis=1)) < 0.3 * self.h_max:
                     break  # going round in circles (a fold of the balanced solutions): the curve ends here
                 if not self.inside(p + 1e-9 * tau) and np.linalg.norm(p - c) < 1e-9:
@@ -622,21 +661,93 @@ class BoundaryTracer:
         full.event = smp.event
         return full
 
-    def _corner(self, p: np.ndarray, tau: np.ndarray, ref: tuple[Sample, Sample | None]):
+    def _corner(self, p: np.ndarray, tau: np.ndarray, n: np.ndarray, ref: tuple[Sample, Sample | None],
+                behind: np.ndarray):
         """On a ring of radius h_max round p, the first verdict change ahead (within 150 degrees of
-        tau), located between the two ring points that disagree."""
+        tau), located between the two ring points that disagree; where there is none, the ring's back
+        (150 to 172.5 degrees either side, finer), then a sliver (:meth:`_sliver`). The back: the far side
+        of a stable region that ends in a wedge sharper than 30 degrees (the moved fan disk, 3D: a Hopf
+        curve meeting another mode's near its critical, where the search within 150 degrees left 319 cells
+        contradicting beyond one cell), unless what it finds is the curve just traced (``behind``: its last
+        points), as at the top of a fold curve, where going back retraced it."""
+        got = self._ring(p, tau, ref, np.arange(-150, 151, 15))
+        if got is not None:
+            return got
+        got = self._ring(p, tau, ref, np.concatenate([np.arange(-172.5, -149, 7.5), np.arange(150, 173, 7.5)]),
+                         wrap=False)
+        if got is not None and _distance_to_polyline(got[0], behind) > 1e-3:
+            return got
+        return self._sliver(p, tau, n, ref)
+
+    def _sliver(self, p: np.ndarray, tau: np.ndarray, n: np.ndarray, ref: tuple[Sample, Sample | None]):
+        """2D: the far side of a stable wedge narrower than the ring's 7.5 degrees whose tip the switch
+        curve has reached, where another blade's event line meets this one's (the moved fan disk: the two
+        lines meet at a fraction of a degree, and the tracer stopped at the tip, leaving 294 cells
+        contradicting beyond one cell). On the ring, from straight behind towards the curve's stable side
+        (-n), the first stable point, then the first unstable one beyond it, the angle between them
+        bisected to 0.01 degrees; the boundary is the other blade's event between the two, found by its
+        fast corrector (the bracket's own event search lands on this blade's line, a ten-thousandth of a
+        cell away). None anywhere else: at the top of a fold curve the far side is the same curve."""
+        if self.continuous or ref[0].event is None:
+            return None
+        r = self.h_max
+        back = math.atan2(-tau[1], -tau[0])
+        # the stable side, seen from behind: rotating from -tau towards -n
+        sense = 1.0 if (-tau[0]) * (-n[1]) - (-tau[1]) * (-n[0]) > 0 else -1.0
+
+        def at(deg: float) -> tuple[np.ndarray, Sample | None]:
+            a = back + sense * math.radians(deg)
+            x = p + r * np.array([math.cos(a), math.sin(a)])
+            return x, (self.sample(x, ref[0].q, ref[0]) if self.inside(x) else None)
+
+        lo = hi = None
+        for deg in (0.02, 0.1, 0.5, 1.5, 4.0, 7.5):
+            x, smp = at(deg)
+            if smp is None:
+                return None
+            if lo is not None and smp.unstable:
+                hi = (deg, x, smp)
+                break
+            if not smp.unstable:
+                lo = (deg, x, smp)
+        if lo is None or hi is None:
+            return None
+        while hi[0] - lo[0] > 0.01:
+            mid = 0.5 * (lo[0] + hi[0])
+            x, smp = at(mid)
+            if smp is None:
+                return None
+            if smp.unstable:
+                hi = (mid, x, smp)
+            else:
+                lo = (mid, x, smp)
+        changed = [k for k, (u, v) in enumerate(zip(lo[2].contact_set, hi[2].contact_set)) if u != v]
+        if len(changed) != 1 or changed[0] == ref[0].event:
+            return None
+        d = hi[1] - lo[1]
+        self._gap_slope = {}
+        return self._fast_event(lo[1], d / float(np.linalg.norm(d)), dataclasses.replace(lo[2], event=changed[0]),
+                                hi[2])
+
+    def _ring(self, p: np.ndarray, tau: np.ndarray, ref: tuple[Sample, Sample | None], degrees: np.ndarray,
+              wrap: bool = True):
+        """The corner search on the ring points at ``degrees`` from tau (neighbours in that list are
+        paired; ``wrap``: False where the list holds two arcs, never paired across their gap)."""
         r = self.h_max
         ang0 = math.atan2(tau[1], tau[0])
-        angles = ang0 + np.radians(np.arange(-150, 151, 15))
+        angles = ang0 + np.radians(degrees)
         ring = [p + r * np.array([math.cos(a), math.sin(a)]) for a in angles]
         q0 = ref[0].q
         samples = [self.sample(x, q0, ref[0]) if self.inside(x) else None for x in ring]
         # a stable solution off the maps' sheet is not what the maps see there
         samples = [x if x is None or x.unstable or self._on_sheet(x) else None for x in samples]
+        step = np.diff(degrees)
         order = np.argsort(np.abs(angles - ang0))  # nearest to straight ahead first
         for k in order:
             for j in (k - 1, k + 1):
                 if not (0 <= j < len(ring)) or samples[k] is None:
+                    continue
+                if not wrap and abs(degrees[max(j, k)] - degrees[min(j, k)]) > 1.5 * np.min(step):
                     continue
                 sk, sj = samples[k], samples[j]
                 if sj is None and self.inside(ring[j]) and not sk.unstable:
@@ -678,6 +789,16 @@ class BoundaryTracer:
                 continue
             return None  # reversed: a sharp turn, the step is too long
         return None
+
+
+def _distance_to_polyline(x: np.ndarray, P: np.ndarray) -> float:
+    """Distance from x to the polyline through the points P (scaled coordinates)."""
+    if len(P) == 1:
+        return float(np.linalg.norm(x - P[0]))
+    a, b = P[:-1], P[1:]
+    d = b - a
+    t = np.clip(np.einsum("ij,ij->i", x - a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-30), 0.0, 1.0)
+    return float(np.min(np.linalg.norm(a + t[:, None] * d - x, axis=1)))
 
 
 def _clip_to_box(p, c, tr: BoundaryTracer):

@@ -5,18 +5,21 @@ Unknowns y = (q / q_s, (p - p_start) / p_s): scaled so that a millimetre of disp
 whole parameter range weigh alike. Predictor: the unit tangent of [dR/dq, dR/dp] (its null
 vector); corrector: Newton on [R(y); t . (y - y_pred)] = 0 (the bordered system). A step is halved
 when the corrector fails or when more than one contact point changes state within it, so each
-accepted step holds at most one contact event. Located along a step (the chord between its ends,
-the corrector solving at each trial position):
+accepted step holds at most one contact event. Located along a step (on the step's own planes,
+normal to its starting tangent, the corrector solving at each trial position: :class:`_Step`):
 
 * **contact**: a contact point's gap crosses zero (regula falsi on the gap, to 1e-9 of the step);
 * **fold**: the parameter component of the tangent changes sign (the branch turns back; a static
   solution is lost or gained), to 1e-6 of the parameter;
-* **hopf**: the critical eigenvalue's real part changes sign within one contact set (regula falsi
-  on Re mu, to |Re mu| <= 1e-8 /s); its imaginary part is the frequency of the cycle it gives
-  birth to;
+* **hopf**: the stability changes within one contact set and the critical eigenvalue's real part
+  is brought to |Re mu| <= 1e-8 /s (regula falsi on Re mu of one mode, after bisecting the verdict
+  until both ends lead with it); its imaginary part is the frequency of the cycle it gives birth to;
 * **switch**: the stability changes at a contact event (2D: the point law's stiffness jumps when a
   blade enters contact, so the eigenvalues jump across the axis; a discontinuity-induced
-  bifurcation, located with the event).
+  bifurcation, located with the event);
+* **unlocated**: a change of stability that is neither (its event not located, or Re mu not brought
+  to 1e-8 /s): reported as such with its reason, never as a Hopf point. A real eigenvalue crossing
+  zero where the step holds a fold is the fold's (``stability_change`` on it).
 """
 
 from __future__ import annotations
@@ -30,10 +33,13 @@ from .equilibria import Equilibria, Point
 from .roots import illinois
 from .stability import RE_TOL
 
+# a Hopf point is reported only where its critical eigenvalue's real part is brought below this [1/s]
+HOPF_TOL = 1e-8
+
 
 @dataclass
 class Special:
-    kind: str  # "hopf", "fold", "contact", "switch"
+    kind: str  # "hopf", "fold", "contact", "switch", "unlocated"
     point: Point
     detail: dict = field(default_factory=dict)
 
@@ -61,7 +67,7 @@ class Branch:
         return np.array([getattr(p, self.parameter) for p in self.points])
 
     def stable(self) -> np.ndarray:
-        return np.array([p.max_real <= RE_TOL for p in self.points])
+        return np.array([p.max_real <= RE_TOL for p in self.points], dtype=bool)  # bool also when empty
 
     def of_kind(self, kind: str) -> list[Special]:
         return [s for s in self.specials if s.kind == kind]
@@ -73,6 +79,10 @@ class _Tracer:
         self.p0, self.ps = start, abs(stop - start)
         self.qs = q_scale
         self.n = eq.n
+        # the residual's scale is the imbalance load; without one (me = 0) a stiffness times the displacement
+        # scale, a millionth of it: the load's 1e-10 would ask |R| <= 1e-40 N, and round-off past g0 = 0 failed
+        w = fixed if parameter == "g0" else start
+        self.f_floor = 1e-6 * float(np.abs(eq.model.K_omega(w)).max()) * q_scale
 
     def args(self, p: float) -> tuple[float, float]:
         return (self.fixed, p) if self.par == "g0" else (p, self.fixed)
@@ -104,7 +114,8 @@ class _Tracer:
         """Newton on [R(y); t.(y - anchor)] with anchor = y_pred (the arclength step)."""
         anchor = y_pred if anchor is None else anchor
         y = y_pred.copy()
-        fnorm = np.linalg.norm(self.eq.model.force(self.args(self.unpack(y)[1])[0], self.eq.me)) + 1e-30
+        fnorm = max(float(np.linalg.norm(self.eq.model.force(self.args(self.unpack(y)[1])[0], self.eq.me))),
+                    self.f_floor)
         for _ in range(max_iter):
             R, Jq, Jp = self.blocks(y)
             g = t @ (y - anchor)
@@ -198,27 +209,70 @@ def continue_static(eq: Equilibria, parameter: str, fixed: float, start: float, 
     return Branch(eq.formulation, parameter, fixed, pts, specials, complete, message)
 
 
+class _Step:
+    """The branch between two accepted points, parametrised as the step's own corrector sees it: the
+    point at s in [0, 1] lies on the plane t_a . (y - y_a) = s t_a . (y_b - y_a), found by Newton from
+    y_a + s (t_a . (y_b - y_a)) t_a (where the step's corrector starts).
+
+    Not the chord's normal planes: across a 2D contact event the branch has a kink (the point law's
+    stiffness jumps), and where the part in contact turns far from the part before it, Newton on a
+    plane normal to the chord cycles between the two linear pieces (measured: friction 0.3, the first
+    contact at Omega = 3.3 was not located and its switch was reported as a Hopf point). On the
+    tangent's planes the piece before the event is crossed at its own predictor and the piece after
+    it by one Newton step, whatever the step length."""
+
+    def __init__(self, tr: _Tracer, ya: np.ndarray, yb: np.ndarray, ta: np.ndarray):
+        self.tr, self.ya, self.yb, self.ta = tr, ya, yb, ta
+        self.d = float(ta @ (yb - ya))
+        self._cache: dict[float, np.ndarray | None] = {0.0: ya, 1.0: yb}
+
+    def at(self, s: float) -> np.ndarray | None:
+        s = float(s)
+        if s in self._cache:
+            return self._cache[s]
+        tr, ya, yb, ta = self.tr, self.ya, self.yb, self.ta
+        y = None
+        if self.d > 1e-6 * float(np.linalg.norm(yb - ya)):
+            anchor = ya + s * self.d * ta
+            y = tr.correct(anchor, ta)
+            if y is None:  # the same plane from the chord's point (a strongly curved step)
+                y = tr.correct(ya + s * (yb - ya), ta, anchor=anchor)
+        else:  # the branch turned by ~90 degrees within the step: the chord's planes
+            y = tr.on_chord(ya, yb, s)
+        self._cache[s] = y
+        return y
+
+    def point(self, s: float, spectrum: bool = True) -> Point | None:
+        y = self.at(s)
+        return None if y is None else self.tr.point(y, spectrum)
+
+
+def _unstable(p: Point) -> bool:
+    return p.max_real > RE_TOL
+
+
 def _locate(tr: _Tracer, ya: np.ndarray, yb: np.ndarray, pa: Point, pb: Point, ta: np.ndarray, tb: np.ndarray,
             spectrum: bool) -> list[Special]:
     out: list[Special] = []
+    step = _Step(tr, ya, yb, ta)
     # fold: the parameter component of the tangent changes sign
     if ta[-1] * tb[-1] < 0:
         def tp(s):
-            y = tr.on_chord(ya, yb, s)
+            y = step.at(s)
             return None if y is None else tr.tangent(y, ta, 1.0)[-1]
 
         s = illinois(tp, ta[-1], tb[-1], 1e-9, retry_midpoint=True)
         if s is not None:
-            y = tr.on_chord(ya, yb, s)
+            y = step.at(s)
             if y is not None:
                 out.append(Special("fold", tr.point(y, spectrum)))
-    s_event = None
+    s_event, event = None, None
     changed = [k for k, (a, b) in enumerate(zip(pa.contact_set, pb.contact_set)) if a != b]
     if changed:
         k = changed[0]
 
         def gap(s):
-            y = tr.on_chord(ya, yb, s)
+            y = step.at(s)
             if y is None:
                 return None
             q, p = tr.unpack(y)
@@ -226,60 +280,140 @@ def _locate(tr: _Tracer, ya: np.ndarray, yb: np.ndarray, pa: Point, pb: Point, t
 
         ga = float(tr.eq.gaps(pa.q, pa.g0).ravel()[k])
         gb = float(tr.eq.gaps(pb.q, pb.g0).ravel()[k])
-        if ga * gb < 0:
+        if (ga < 0) != (gb < 0) and ga != gb:
             s_event = illinois(gap, ga, gb, 1e-9, f_tol=1e-15, retry_midpoint=True)
         if s_event is not None:
-            y = tr.on_chord(ya, yb, s_event)
-            if y is not None:
-                ev = tr.point(y, spectrum)
-                out.append(Special("contact", ev, {"point_index": k, "entering": bool(pb.contact_set[k])}))
+            ev = step.point(s_event, spectrum)
+            if ev is not None:
+                event = Special("contact", ev, {"point_index": k, "entering": bool(pb.contact_set[k])})
+            else:
+                s_event = None
     if not spectrum:
+        return out + ([event] if event is not None else [])
+    if event is None:
+        if _unstable(pa) != _unstable(pb):
+            # a change of stability with an event we could not place is not taken for a Hopf point
+            out.append(_unlocated(pb, "the contact event within the step was not located") if changed
+                       else _crossing(step, 0.0, 1.0, pa, pb))
+        return _at_fold(out)
+    sides = _event_sides(step, s_event, k, pa, pb)
+    if sides is None:
+        out.append(event)
+        if _unstable(pa) != _unstable(pb):
+            out.append(_unlocated(event.point, "no solution either side of the contact event"))
         return out
-    unstable_a, unstable_b = pa.mu.real > 0, pb.mu.real > 0
-    if s_event is None:
-        if unstable_a != unstable_b:
-            out.append(_hopf(tr, ya, yb, 0.0, 1.0, pa, pb))
-        return out
-    # an event inside the step: the spectrum on either side of it
-    eps = 1e-7
-    left = tr.on_chord(ya, yb, max(s_event - eps, 0.0))
-    right = tr.on_chord(ya, yb, min(s_event + eps, 1.0))
-    if left is None or right is None:
-        return out
-    pl, pr = tr.point(left), tr.point(right)
-    if (pl.mu.real > 0) != unstable_a:
-        out.append(_hopf(tr, ya, yb, 0.0, s_event - eps, pa, pl))
-    if (pl.mu.real > 0) != (pr.mu.real > 0):
-        ev = out[-1].point if out and out[-1].kind == "contact" else pl
-        out.append(Special("switch", ev, {"left_real_part": pl.mu.real, "right_real_part": pr.mu.real,
-                                          "left_frequency_rad_s": abs(pl.mu.imag),
-                                          "right_frequency_rad_s": abs(pr.mu.imag)}))
-    if (pr.mu.real > 0) != unstable_b:
-        out.append(_hopf(tr, ya, yb, s_event + eps, 1.0, pr, pb))
+    (sl, pl), (sr, pr) = sides
+    if _unstable(pl) != _unstable(pa):
+        out.append(_crossing(step, 0.0, sl, pa, pl))
+    out.append(event)
+    if _unstable(pl) != _unstable(pr):
+        direction = "destabilising" if _unstable(pr) else "stabilising"
+        out.append(Special("switch", event.point, {
+            "left_real_part": pl.max_real, "right_real_part": pr.max_real, "left_frequency_rad_s": abs(pl.mu.imag),
+            "right_frequency_rad_s": abs(pr.mu.imag), "direction": direction}))
+    if _unstable(pr) != _unstable(pb):
+        out.append(_crossing(step, sr, 1.0, pr, pb))
+    return _at_fold(out)
+
+
+def _at_fold(out: list[Special]) -> list[Special]:
+    """A real eigenvalue crossing zero in a step holding a fold is the fold's change of stability (the
+    static Jacobian is singular there): noted on the fold, not reported as unlocated."""
+    folds = [s for s in out if s.kind == "fold"]
+    static = [s for s in out if s.kind == "unlocated" and s.detail.get("static")]
+    if folds and static:
+        folds[0].detail["stability_change"] = True
+        out = [s for s in out if all(s is not t for t in static)]
     return out
 
 
-def _hopf(tr: _Tracer, ya: np.ndarray, yb: np.ndarray, s0: float, s1: float, pa: Point, pb: Point) -> Special:
-    """Locate Re mu = 0 between chord fractions s0 and s1 (one contact set), refining mu by Newton
-    from the nearer end's eigenvalue (the pair is followed, not re-picked)."""
-    state = {"mu": pa.mu, "v": None}
+def _event_sides(step: _Step, s_event: float, k: int, pa: Point,
+                 pb: Point) -> tuple[tuple[float, Point], tuple[float, Point]] | None:
+    """The solutions just before and just after the event at s_event, each with its end's state of
+    contact point k: ((s, point), (s, point)), or None where either is not found."""
+    out: list[tuple[float, Point]] = []
+    for side, end in ((-1.0, pa), (1.0, pb)):
+        found = None
+        for eps in (1e-7, 1e-6, 1e-5, 1e-4):
+            s = min(max(s_event + side * eps, 0.0), 1.0)
+            p = step.point(s)
+            if p is not None and p.contact_set[k] == end.contact_set[k]:
+                found = (s, p)
+                break
+        if found is None:
+            return None
+        out.append(found)
+    return out[0], out[1]
+
+
+def _unlocated(p: Point, reason: str) -> Special:
+    return Special("unlocated", p, {"reason": reason})
+
+
+def _same_mode(tr: _Tracer, stable: Point, unstable: Point) -> tuple[bool, complex]:
+    """Is the unstable end's critical eigenvalue, followed to the stable end by Newton, the stable end's
+    critical one (then the crossing between them is that mode's alone)? Also: the followed eigenvalue
+    at the stable end."""
+    mu, _ = tr.eq.refine(stable.q, stable.omega, stable.g0, unstable.mu)
+    return bool(abs(mu - stable.mu) <= 1e-6 * abs(stable.mu)), mu
+
+
+def _crossing(step: _Step, s0: float, s1: float, p0: Point, p1: Point) -> Special:
+    """The change of stability between s0 and s1 (one contact set, or a continuous law): a Hopf point
+    where the critical eigenvalue's real part is brought to |Re mu| <= 1e-8 /s, otherwise what it is.
+
+    First the verdict (whole spectra) is bisected until the critical eigenvalues at the two ends are the
+    same mode: another mode may lead at one end (a step across a contact event, or a long one), and
+    regula falsi on a mode followed from one end would then converge on a jump between modes, not a
+    root. Then regula falsi on the real part of that mode, followed by Newton from the unstable end."""
+    tr = step.tr
+    destabilising = _unstable(p1)
+    for _ in range(48):
+        st, un = (p0, p1) if destabilising else (p1, p0)
+        if un.max_real > un.mu.real + 1e-9 and un.mu.real <= RE_TOL:
+            out = _unlocated(un, "a real eigenvalue crosses zero (a static bifurcation, not a Hopf point)")
+            out.detail["static"] = True
+            return out
+        same, mu_st = _same_mode(tr, st, un)
+        if same:
+            break
+        if s1 - s0 <= 1e-12:
+            return _unlocated(un, "the critical mode changes at the crossing (a discontinuity of the spectrum)")
+        sm = 0.5 * (s0 + s1)
+        pm = step.point(sm)
+        if pm is None:
+            return _unlocated(un, "the corrector failed while bracketing the crossing")
+        if _unstable(pm) == _unstable(p0):
+            s0, p0 = sm, pm
+        else:
+            s1, p1 = sm, pm
+    else:
+        return _unlocated(p1, "the crossing could not be bracketed")
+    state = {"mu": un.mu, "v": None}
 
     def re(frac):
-        y = tr.on_chord(ya, yb, s0 + frac * (s1 - s0))
+        y = step.at(s0 + frac * (s1 - s0))
         if y is None:
             return None
         q, p = tr.unpack(y)
         w, g = tr.args(p)
         mu, v = tr.eq.refine(q, w, g, state["mu"], state["v"])
-        state["mu"], state["v"], state["y"] = mu, v, y
+        state["mu"], state["v"] = mu, v
         return mu.real
 
-    frac = illinois(re, pa.mu.real, pb.mu.real, 1e-12, f_tol=1e-10, retry_midpoint=True)
-    y = tr.on_chord(ya, yb, s0 + frac * (s1 - s0))
+    f0 = mu_st.real if p0 is st else un.mu.real
+    f1 = un.mu.real if p1 is un else mu_st.real
+    frac = illinois(re, f0, f1, 1e-12, f_tol=1e-10, retry_midpoint=True)
+    y = None if frac is None else step.at(s0 + frac * (s1 - s0))
+    if y is None:
+        return _unlocated(un, "the corrector failed while locating the crossing")
     pt = tr.point(y, False)
     q, p = tr.unpack(y)
     w, g = tr.args(p)
     pt.mu, _ = tr.eq.refine(q, w, g, state["mu"], state["v"])
     pt.max_real = pt.mu.real
-    return Special("hopf", pt, {"frequency_rad_s": abs(pt.mu.imag), "direction": "destabilising"
-                                if pb.mu.real > pa.mu.real else "stabilising"})
+    detail = {"frequency_rad_s": abs(pt.mu.imag), "direction": "destabilising" if destabilising else "stabilising"}
+    if abs(pt.mu.real) > HOPF_TOL:
+        return Special("unlocated", pt, {"reason": f"|Re mu| = {abs(pt.mu.real):.3g} /s at the located point, "
+                                                   f"above {HOPF_TOL:g}: not a Hopf point", **detail})
+    return Special("hopf", pt, detail)

@@ -1,14 +1,16 @@
 """``run_continuation``: static branches, their special points, the periodic orbits the
 instability grows into, and the stability boundary as curves over the grid maps.
 
-For each formulation, at the study speed (3.3 omega_ref, the paper's section-6 speed):
+For each formulation, at the study speed (:func:`study_speed`: the paper's section-6 speed 3.3
+omega_ref where it lies on the configuration's grid, else the configuration's first critical speed):
 
 1. the balanced solutions continued in g0 from the top of the map's range to contact at g0 = 0
    (``branch.continue_static``), with contact events, folds, Hopf points and contact-induced
-   stability switches located;
-2. the periodic orbits: from the first destabilising Hopf point (amplitude growing from zero), or,
-   where the stability is lost at a contact event (2D), from the state a transient settles on
-   past it, continued in g0 both ways, with their Floquet multipliers (``periodic``);
+   stability switches located (a change of stability that cannot be located as either is reported
+   as "unlocated", never as a Hopf point);
+2. the periodic orbits: from the first loss of stability where it is a Hopf point (amplitude
+   growing from zero), or, where it is lost at a contact event (2D), from the state a transient
+   settles on past it, continued in g0 both ways, with their Floquet multipliers (``periodic``);
 3. the stability boundary over the map's (Omega, g0) range as curves (``boundary``), checked
    against the grid maps: every grid cell whose verdict contradicts the side of the curve it lies
    on should be within one cell of the curve.
@@ -46,17 +48,23 @@ class ContinuationResult:
     agreement: dict[str, dict]
     timings: dict[str, float]
     maps: dict[str, StabilityMap] = field(default_factory=dict)
+    speed_source: str = "given"
 
     def summary(self) -> dict:
-        out: dict = {"speed": self.speed, "timings_s": self.timings}
+        out: dict = {"speed": self.speed, "speed_source": self.speed_source, "timings_s": self.timings}
         for f, b in self.branches.items():
+            hopf = b.of_kind("hopf")
             out[f] = {
                 "branch": {"points": len(b.points), "complete": b.complete, "message": b.message},
                 "specials": [s.summary() for s in b.specials if s.kind != "contact"],
+                # "unlocated": a change of stability whose refinement did not reach a Hopf point's
+                # |Re mu| <= 1e-8 /s nor a contact event (reported as such, never as a Hopf point)
+                "special_counts": {k: len(b.of_kind(k)) for k in ("hopf", "switch", "fold", "unlocated")},
+                "hopf_max_abs_real_part": max((abs(s.point.mu.real) for s in hopf), default=None),
                 "contact_events": len(b.of_kind("contact")),
                 "orbit_branches": [
-                    {"start": "hopf" if ob.hopf_g0 is not None else "transient", "message": ob.message,
-                     "hopf_g0_m": ob.hopf_g0, "hopf_frequency_rad_s": ob.hopf_frequency,
+                    {"start": ob.notes.get("start", "hopf" if ob.hopf_g0 is not None else "transient"),
+                     "message": ob.message, "hopf_g0_m": ob.hopf_g0, "hopf_frequency_rad_s": ob.hopf_frequency,
                      "orbits": [o.summary() for o in ob.orbits], **ob.notes}
                     for ob in self.orbits.get(f, [])],
                 "boundary": {"curves": len(self.curves.get(f, [])),
@@ -67,35 +75,43 @@ class ContinuationResult:
         return out
 
     def plot(self, path: str | Path) -> Path:
+        """Bifurcation diagrams in g0: the fan-disk centre's distance from the axis, for the static
+        solutions and (its largest and smallest over the period) for the orbits: the same quantity, so
+        that an orbit born at a Hopf point starts on its static branch."""
         plt = pyplot()
-        fig, axes = plt.subplots(1, len(self.branches), figsize=(6 * len(self.branches), 4.5), squeeze=False)
+        fig, axes = plt.subplots(1, max(len(self.branches), 1), figsize=(6 * max(len(self.branches), 1), 4.5),
+                                 squeeze=False)
         for ax, (f, b) in zip(axes[0], self.branches.items()):
-            g = np.array([p.g0 for p in b.points]) * 1e3
-            F = np.array([p.max_force for p in b.points])
-            st = b.stable()
+            ax.set_title(f"{f}, Ω = {self.speed:g} Ω_ref")
+            ax.set_xlabel("clearance g0 [mm]")
+            ax.set_ylabel("fan-disk centre from the axis [mm]\n(orbits: largest and smallest over the period)")
+            ax.grid(alpha=0.3)
+            if not b.points:
+                ax.text(0.5, 0.5, b.message or "no balanced solution", ha="center", va="center", transform=ax.transAxes)
+                continue
+            g, r, st = _joined(b)
             for mask, style, lab in ((st, "-", "static, stable"), (~st, "--", "static, unstable")):
-                y = np.where(mask, F, np.nan)
-                ax.plot(g, y, style, color="C0", lw=1.5, label=lab)
+                ax.plot(g, np.where(mask, r, np.nan), style, color="C0", lw=1.5, label=lab)
             for ob in self.orbits.get(f, []):
+                if not ob.orbits:
+                    continue
                 go = np.array([o.g0 for o in ob.orbits]) * 1e3
-                Fo = np.array([o.max_force for o in ob.orbits])
-                so = np.array([o.stable for o in ob.orbits])
-                ax.plot(go[so], Fo[so], "o", color="C3", ms=4, label="periodic, stable")
-                ax.plot(go[~so], Fo[~so], "o", mfc="none", color="C3", ms=4, label="periodic, unstable")
-            marks = {"hopf": ("^", "C2", "Hopf"), "fold": ("s", "k", "fold"), "switch": ("D", "C1", "switch")}
+                so = np.array([o.stable for o in ob.orbits], dtype=bool)
+                for attr in ("disk_max_radius", "disk_min_radius"):
+                    ro = np.array([getattr(o, attr) for o in ob.orbits]) * 1e3
+                    ax.plot(go[so], ro[so], "o", color="C3", ms=4, label="periodic, stable")
+                    ax.plot(go[~so], ro[~so], "o", mfc="none", color="C3", ms=4, label="periodic, unstable")
+            marks = {"hopf": ("^", "C2", "Hopf"), "fold": ("s", "k", "fold"), "switch": ("D", "C1", "switch"),
+                     "unlocated": ("X", "C4", "stability change, unlocated")}
             for kind, (m, c, lab) in marks.items():
                 sp = b.of_kind(kind)
                 if sp:
-                    ax.plot([s.point.g0 * 1e3 for s in sp], [s.point.max_force for s in sp], m, color=c, ms=8,
-                            label=lab)
+                    ax.plot([s.point.g0 * 1e3 for s in sp], [s.point.disk_amplitude * 1e3 for s in sp], m, color=c,
+                            ms=8, label=lab)
             touching = [p.g0 for p in b.points if p.n_contact > 0]
-            if touching:  # the contact part of the branch, with the first clearance-only stretch
+            if touching and max(touching) > 0:  # the contact part of the branch, with the first clearance-only stretch
                 ax.set_xlim(0.0, 1.3 * max(touching) * 1e3)
-            ax.set_xlabel("clearance g0 [mm]")
-            ax.set_ylabel("largest blade normal force [N] (orbits: over the period)")
-            ax.set_title(f"{f}, Ω = {self.speed:g} Ω_ref")
             _legend(ax)
-            ax.grid(alpha=0.3)
         return save_figure(fig, path)
 
     def plot_boundaries(self, path: str | Path) -> Path:
@@ -136,6 +152,28 @@ class ContinuationResult:
         s = self.summary()
         write_json(out / "summary.json", s)
         return s
+
+
+def _joined(b: Branch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The branch's (g0 [mm], disk distance [mm], stable) with the special point between two points of
+    different verdicts put in twice, once of each, so that the stable and the unstable line meet there
+    (else the step across the change is drawn by neither)."""
+    specials = [s.point for s in b.specials if s.kind in ("switch", "hopf", "fold", "unlocated")]
+    st = b.stable()
+    G: list[float] = []
+    R: list[float] = []
+    S: list[bool] = []
+    for i, p in enumerate(b.points):
+        if i and st[i] != st[i - 1]:
+            lo, hi = sorted((b.points[i - 1].g0, p.g0))
+            at = next((x for x in specials if lo <= x.g0 <= hi), p)
+            G += [at.g0, at.g0]
+            R += [at.disk_amplitude, at.disk_amplitude]
+            S += [bool(st[i - 1]), bool(st[i])]
+        G.append(p.g0)
+        R.append(p.disk_amplitude)
+        S.append(bool(st[i]))
+    return np.array(G) * 1e3, np.array(R) * 1e3, np.array(S, dtype=bool)
 
 
 def _legend(ax) -> None:
@@ -189,11 +227,38 @@ def agreement(curves: list[Curve], mp: StabilityMap, cell: tuple[float, float]) 
         for i in range(ns):
             dist[i] = np.min(np.linalg.norm(xy[i][:, None, :] - P[None, :, :], axis=-1), axis=1)
     beyond = bad & (dist > 1.0 + 1e-9)
+    off = off_branch(mp)
     n_valid = max(int(valid.sum()), 1)
-    return {"grid_cells": int(valid.sum()), "regions": int(len(np.unique(roots[valid]))),
-            "contradicting_cells": int(bad.sum()), "contradicting_fraction": float(bad.sum() / n_valid),
-            "contradicting_beyond_one_cell": int(beyond.sum()),
-            "contradicting_beyond_one_cell_fraction": float(beyond.sum() / n_valid)}
+    out = {"grid_cells": int(valid.sum()), "regions": int(len(np.unique(roots[valid]))),
+           "contradicting_cells": int(bad.sum()), "contradicting_fraction": float(bad.sum() / n_valid),
+           "contradicting_beyond_one_cell": int(beyond.sum()),
+           "contradicting_beyond_one_cell_fraction": float(beyond.sum() / n_valid),
+           "contradicting_off_branch": int((bad & off).sum()),
+           "contradicting_beyond_one_cell_off_branch": int((beyond & off).sum()),
+           "off_branch_cells": int((off & valid).sum())}
+    if beyond.any():
+        on = int((beyond & ~off).sum())
+        rest = f"; {on} are on it, across a boundary the tracer did not follow" if on else ""
+        out["reason"] = (
+            f"{int((beyond & off).sum())} of the {int(beyond.sum())} cells beyond one cell of every curve are not "
+            "continued from the branch the map follows down in g0 (at or below a cell of their speed solved from a "
+            "contact-set start or left without a solution: another equilibrium, which the curves, continued from "
+            f"their neighbours on the followed branch, do not bound){rest}. The grid map is the reference there "
+            "(docs/THEORY.md, section 5.1).")
+    return out
+
+
+def off_branch(mp: StabilityMap) -> np.ndarray:
+    """Cells whose equilibrium the map did not continue from the branch it follows down in g0 at their
+    speed: at or below (in g0) a cell of the same speed solved from a contact-set start or left without a
+    solution, from which the sweep went on warm-started from another equilibrium, or from scratch."""
+    order = np.argsort(mp.g0s)[::-1]  # the map's sweep: largest clearance first
+    rescued = mp.no_solution.copy()
+    if mp.from_contact_set is not None:
+        rescued |= mp.from_contact_set > 0
+    off = np.zeros_like(rescued)
+    off[:, order] = np.logical_or.accumulate(rescued[:, order], axis=1)
+    return off
 
 
 def _cuts(a: np.ndarray, b: np.ndarray, S: np.ndarray) -> bool:
@@ -208,52 +273,104 @@ def _cuts(a: np.ndarray, b: np.ndarray, S: np.ndarray) -> bool:
     return bool(np.any((o1 * o2 <= 0) & (o3 * o4 <= 0)))
 
 
-def _orbits_2d(eq: Equilibria, branch: Branch, omega: float, max_orbits: int) -> list[OrbitBranch]:
-    """Where the 2D solution loses stability at a contact event: the orbit a transient settles on
-    past it, continued both ways."""
+def _orbits(eq: Equilibria, branch: Branch, omega: float, max_orbits: int) -> list[OrbitBranch]:
+    """The periodic orbits past the first loss of stability along the branch: from a destabilising Hopf
+    point when that comes first, else from where a transient settles past the first unstable stretch."""
+    lost = [s for s in branch.specials if s.kind in ("hopf", "switch", "unlocated")
+            and s.detail.get("direction", "destabilising") == "destabilising"]
+    if lost and lost[0].kind == "hopf":
+        h = lost[0].point
+        ob = continue_orbits_from_hopf(eq, omega, h.g0, h.mu, 0.0, max_orbits=max_orbits)
+        ob.notes = {"start": "hopf"}
+        return [ob]
+    return _orbits_from_transient(eq, branch, omega, max_orbits)
+
+
+def _orbits_from_transient(eq: Equilibria, branch: Branch, omega: float, max_orbits: int) -> list[OrbitBranch]:
+    """Where the solution loses stability at a contact event (2D: a switch, no Hopf point), the orbit a
+    transient settles on past it, continued both ways."""
     unstable = [p for p in branch.points if p.max_real is not None and p.max_real > 0.1]
     if not unstable:
         return []
     p = unstable[0]
     g0 = p.g0
-    q = p.q
-    q0, v0 = eq.unstable_start(q, omega, g0, p.mu, 1e-5)
-    tr = run_transient(eq.model, eq.contact(g0), omega, t_end=40.0, t_ramp=0.0, me=eq.me, q0=q0, v0=v0,
-                       record_dt=5e-4)
-    if tr.diverged or len(tr.q) < 100:
-        return [OrbitBranch(eq.formulation, omega, [], f"the transient at g0 = {g0:.4g} m diverged: no orbit")]
+    q0, v0 = eq.unstable_start(p.q, omega, g0, p.mu, 1e-5)
+    # 40 s chunks until the disk's peak-to-peak over the last 2 s is within 3 % of that 10 s before, 200 s at
+    # most: friction 0.3 (2D, Re = +0.24 /s) settles only after ~70 s, and shooting from its state at 40 s
+    # converged on the static solution
+    elapsed, record_dt = 0.0, 5e-4
+    while True:
+        tr = run_transient(eq.model, eq.contact(g0), omega, t_end=40.0, t_ramp=0.0, me=eq.me, q0=q0, v0=v0,
+                           record_dt=record_dt)
+        elapsed += 40.0
+        if tr.diverged or len(tr.q) < 100:
+            notes = {"start": "transient", "seed_g0_m": g0, "seed_transient_s": elapsed}
+            return [OrbitBranch(eq.formulation, omega, [], f"the transient at g0 = {g0:.4g} m diverged: no orbit",
+                                notes=notes)]
+        d = tr.q @ eq._T2.T
+        w = int(2.0 / record_dt)
+        last, before = np.ptp(d[-w:], axis=0).max(), np.ptp(d[-6 * w:-5 * w], axis=0).max()
+        if abs(last - before) <= 0.03 * last or elapsed >= 200.0:
+            break
+        q0, v0 = tr.q[-1], (tr.q[-1] - tr.q[-2]) / (tr.t[1] - tr.t[0])
+    notes = {"start": "transient", "seed_g0_m": g0, "seed_transient_s": elapsed}
     d = tr.q[-4000:] @ eq._T2.T
     x = d[:, 0] - d[:, 0].mean()
     up = np.flatnonzero((x[1:] > 0) & (x[:-1] <= 0))
     if len(up) < 3:
-        return [OrbitBranch(eq.formulation, omega, [], "the transient settled: no oscillation")]
+        return [OrbitBranch(eq.formulation, omega, [], "the transient settled: no oscillation", notes=notes)]
     period = float(np.mean(np.diff(up)) * (tr.t[1] - tr.t[0]))
     qd = (tr.q[-1] - tr.q[-2]) / (tr.t[1] - tr.t[0])
     o = orbit_from_state(eq, omega, g0, tr.q[-1], qd, period)
     if o is None:
-        return [OrbitBranch(eq.formulation, omega, [], "shooting from the settled transient did not converge")]
-    switch = branch.of_kind("switch")
-    top = switch[0].point.g0 if switch else branch.points[0].g0
+        return [OrbitBranch(eq.formulation, omega, [], "shooting from the transient's last state found no orbit (not "
+                            "converged, or converged on the static solution: the transient had not settled)",
+                            notes=notes)]
+    switch = [s for s in branch.of_kind("switch") if s.point.g0 >= g0]
+    top = switch[-1].point.g0 if switch else branch.points[0].g0
     up_branch = continue_orbits(eq, o, top, max_orbits=max_orbits // 2)
     down_branch = continue_orbits(eq, o, 0.0, max_orbits=max_orbits // 2)
-    up_branch.notes = {"seed_g0_m": g0, "seed_transient_s": 40.0}
-    down_branch.notes = {"seed_g0_m": g0, "seed_transient_s": 40.0}
+    up_branch.notes = dict(notes)
+    down_branch.notes = dict(notes)
     return [up_branch, down_branch]
 
 
+PAPER_SPEED = 3.3  # the paper's section-6 speed (normalised)
+
+
+def study_speed(model: Model, speeds: np.ndarray) -> tuple[float, str]:
+    """The speed of the g0 branches on this configuration, and why: the paper's when it lies on the
+    configuration's own speed range (as the transient study picks its point), else the configuration's
+    first critical speed (where the paper's speed sits relative to the reference's: the rub is strongest
+    there), else the middle of the range."""
+    lo, hi = float(np.min(speeds)), float(np.max(speeds))
+    if lo <= PAPER_SPEED <= hi:
+        return PAPER_SPEED, "the paper's speed, on this configuration's grid"
+    from .linear import run_response
+
+    crit = run_response(model, lo, hi, 400).critical_speeds
+    if len(crit):
+        return float(crit[0]), "this configuration's first critical speed (the paper's is off its grid)"
+    return 0.5 * (lo + hi), "the middle of the grid's speeds (no critical speed on it)"
+
+
 def run_continuation(model: Model, maps: dict[str, StabilityMap] | None = None, speeds: np.ndarray | None = None,
-                     g0s: np.ndarray | None = None, speed: float = 3.3, quick: bool = True,
+                     g0s: np.ndarray | None = None, speed: float | None = None, quick: bool = True,
                      formulations: tuple[str, ...] = FORMULATIONS, boundaries: bool = True,
                      progress: bool = False) -> ContinuationResult:
-    """Branches at ``speed`` (normalised) in g0 over the map range, orbits, and boundary curves
-    over the maps' (or ``speeds`` x ``g0s``) range, compared with the maps when given."""
-    wref = model.params.normalisation.omega_ref
-    omega = speed * wref
+    """Branches at ``speed`` (normalised; default :func:`study_speed`) in g0 over the map range, orbits,
+    and boundary curves over the maps' (or ``speeds`` x ``g0s``) range, compared with the maps when
+    given."""
     if maps:
         any_map = next(iter(maps.values()))
         speeds, g0s = any_map.speeds, any_map.g0s
     if speeds is None or g0s is None:
         raise ValueError("speeds and g0s (or maps) are needed: the range of the boundary curves")
+    source = "given"
+    if speed is None:
+        speed, source = study_speed(model, np.asarray(speeds))
+    wref = model.params.normalisation.omega_ref
+    omega = speed * wref
     max_orbits = 24 if quick else 60
     branches, orbits, curves, agree, timings = {}, {}, {}, {}, {}
     for f in formulations:
@@ -263,12 +380,7 @@ def run_continuation(model: Model, maps: dict[str, StabilityMap] | None = None, 
         branches[f] = b
         timings[f"branch_{f}"] = time.perf_counter() - t0
         t0 = time.perf_counter()
-        hopf = [s for s in b.of_kind("hopf") if s.detail.get("direction") == "destabilising"]
-        if hopf:
-            h = hopf[0].point
-            orbits[f] = [continue_orbits_from_hopf(eq, omega, h.g0, h.mu, 0.0, max_orbits=max_orbits)]
-        else:
-            orbits[f] = _orbits_2d(eq, b, omega, max_orbits)
+        orbits[f] = _orbits(eq, b, omega, max_orbits) if b.points else []
         timings[f"orbits_{f}"] = time.perf_counter() - t0
         if progress:
             print(f"continuation {f}: branch {len(b.points)} points, {len(b.specials)} special points")
@@ -281,7 +393,7 @@ def run_continuation(model: Model, maps: dict[str, StabilityMap] | None = None, 
                         "points_by_corrector": info["points_by_corrector"]}
             if maps and f in maps:
                 agree[f].update(agreement(cv, maps[f], tuple(info["cell"])))
-    return ContinuationResult(speed, branches, orbits, curves, agree, timings, maps or {})
+    return ContinuationResult(speed, branches, orbits, curves, agree, timings, maps or {}, source)
 
 
 def boundary_curves_only(model: Model, formulation: str, speeds: np.ndarray, g0s: np.ndarray,
@@ -290,4 +402,5 @@ def boundary_curves_only(model: Model, formulation: str, speeds: np.ndarray, g0s
     return trace_boundaries(Equilibria(model, formulation), np.asarray(speeds), np.asarray(g0s), resolution)
 
 
-__all__ = ["ContinuationResult", "agreement", "boundary_curves_only", "run_continuation"]
+__all__ = ["PAPER_SPEED", "ContinuationResult", "agreement", "boundary_curves_only", "off_branch",
+           "run_continuation", "study_speed"]

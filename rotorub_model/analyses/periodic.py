@@ -32,6 +32,10 @@ from .equilibria import Equilibria
 from .transient import CentralDifference
 
 MULTIPLIER_TOL = 1e-6  # a multiplier within this of the unit circle is neutral (finite-difference resolution)
+# [m] an "orbit" whose fan disk moves less than this is the static solution (a fixed point of the flow for any
+# period, which shooting converges on from a transient that has not settled: measured 1e-15 m, against 1e-7 m
+# for the first orbit a step from a Hopf point)
+TRIVIAL_PEAK_TO_PEAK = 1e-12
 
 
 @dataclass
@@ -45,11 +49,19 @@ class Orbit:
     disk_mean_radius: float  # [m] mean distance of the fan-disk centre from the axis
     max_force: float  # [N] largest blade normal force over the period
     residual: float  # |Phi_T(x) - x| / |x_s|
+    # [m] the fan-disk centre's largest and smallest distance from the axis over the period: the static
+    # branch's disk_amplitude is that distance, so an orbit born at a Hopf point starts on the branch
+    disk_max_radius: float = math.nan
+    disk_min_radius: float = math.nan
 
     @property
     def stable(self) -> bool:
         # the multipliers come from central differences of the flow: resolved to ~1e-8
         return bool(self.multipliers.size == 0 or np.abs(self.multipliers).max() < 1.0 + MULTIPLIER_TOL)
+
+    @property
+    def trivial(self) -> bool:
+        return self.disk_peak_to_peak < TRIVIAL_PEAK_TO_PEAK
 
     @property
     def frequency(self) -> float:
@@ -59,8 +71,9 @@ class Orbit:
         return {"omega_rad_s": self.omega, "g0_m": self.g0, "period_s": self.period,
                 "frequency_rad_s": self.frequency, "stable": self.stable,
                 "largest_multiplier": float(np.abs(self.multipliers).max()) if self.multipliers.size else 0.0,
-                "disk_peak_to_peak_m": self.disk_peak_to_peak, "max_force_N": self.max_force,
-                "residual": self.residual}
+                "disk_peak_to_peak_m": self.disk_peak_to_peak, "disk_radius_range_m": [self.disk_min_radius,
+                                                                                        self.disk_max_radius],
+                "max_force_N": self.max_force, "residual": self.residual}
 
 
 @dataclass
@@ -109,8 +122,9 @@ class Shooting:
         d = rec @ self._T2.T
         c = self.eq.contact(g0)
         fmax = float(c.split_outputs(c.outputs_array(rec, self.omega))["F_N"].max())
+        r = np.hypot(d[:, 0], d[:, 1])
         return Orbit(self.omega, float(g0), x.copy(), float(T), multipliers, float(np.ptp(d, axis=0).max()),
-                     float(np.hypot(d[:, 0], d[:, 1]).mean()), fmax, float(residual))
+                     float(r.mean()), fmax, float(residual), float(r.max()), float(r.min()))
 
 
 def _multipliers(D: np.ndarray) -> np.ndarray:
@@ -242,7 +256,10 @@ def _follow(solver: _OrbitSolver, z: np.ndarray, tau: np.ndarray, g0_from: float
             continue
         x, T, g0 = solver.unpack(z_new)
         D = solver.monodromy(z_new)
-        orbits.append(sh.orbit(x, T, g0, res, _multipliers(D if D is not None else J[:2 * n, :2 * n] + np.eye(2 * n))))
+        o = sh.orbit(x, T, g0, res, _multipliers(D if D is not None else J[:2 * n, :2 * n] + np.eye(2 * n)))
+        if o.trivial:
+            return orbits, f"the orbits shrank onto the static solution at g0 = {g0:.6g} m"
+        orbits.append(o)
         tau = solver.tangent(J, tau)
         z = z_new
         if (g0 - g0_stop) * (g0_from - g0_stop) <= 0:
@@ -304,4 +321,5 @@ def orbit_from_state(eq: Equilibria, omega: float, g0: float, q: np.ndarray, qdo
         return None
     x, T, g = solver.unpack(z)
     D = solver.monodromy(z)
-    return sh.orbit(x, T, g, res, _multipliers(D if D is not None else J[:2 * n, :2 * n] + np.eye(2 * n)))
+    o = sh.orbit(x, T, g, res, _multipliers(D if D is not None else J[:2 * n, :2 * n] + np.eye(2 * n)))
+    return None if o.trivial else o

@@ -229,7 +229,8 @@ def cmd_detect(ns: argparse.Namespace) -> dict:
 
 @command("continuation", "static branches with their Hopf, fold and switch points, the periodic orbits past "
          "them, and the stability boundary as curves over the (speed, g0) maps")
-@arg("--speed", type=float, default=3.3, help="normalised speed of the g0 branches and orbits (default 3.3)")
+@arg("--speed", type=float, default=None, help="normalised speed of the g0 branches and orbits (default: the "
+     "paper's 3.3 when it lies on this configuration's map grid, else the configuration's first critical speed)")
 @arg("--maps", default=None, help="a stability study's folder (rotorub stability --out DIR) to draw the curves over "
      "and check them against; default: the quick maps are computed")
 @arg("--quick", action="store_true", help="fewer periodic orbits per branch")
@@ -247,7 +248,7 @@ def cmd_reproduce(ns: argparse.Namespace) -> dict:
     from .reproduce import run_reproduce
 
     model = _model(ns)
-    s = run_reproduce(model, ns.out, quick=ns.quick)
+    s = run_reproduce(model, ns.out, quick=ns.quick, params_file=ns.params)
     if not ns.no_fmu:
         from ..errors import ParameterError
 

@@ -386,8 +386,8 @@ def run_transient_study(model: Model, out: str | Path, speed: float | None = Non
     return TransientStudy(speed, g0, runs, statics).save(out)
 
 
-def run_continuation_study(model: Model, out: str | Path, speed: float = 3.3, maps_dir: str | Path | None = None,
-                           quick: bool = True, progress: bool = True) -> dict:
+def run_continuation_study(model: Model, out: str | Path, speed: float | None = None,
+                           maps_dir: str | Path | None = None, quick: bool = True, progress: bool = True) -> dict:
     """Branches, special points, orbits and boundary curves (``analyses.continuation``) against the
     stability maps of ``maps_dir`` (or the quick maps, computed here)."""
     from ..analyses.continuation import run_continuation
