@@ -31,7 +31,8 @@ def _library_run(model, formulation, g0, omega, t_end, closure=0.0, offset=(0.0,
     p = model.params
     liner = Liner(c, LINER["yield_force"], LINER["hardening"], p.abradable.thickness, LINER["n_sectors"], wears=True,
                   closure=closure, offset=offset, radius=p.blades.tip_radius,
-                  band=p.contact.chord * np.cos(np.radians(p.blades.stagger_deg)))
+                  band=p.contact.chord * np.cos(np.radians(p.blades.stagger_deg)),
+                  tip_area=p.blades.thickness * p.contact.chord)
     r = run_transient(model, c, omega, t_end=t_end, t_ramp=0.0, me=p.imbalance.me, record_dt=1e-3, hold=1e-3,
                       liner=liner)
     return r, liner

@@ -130,7 +130,8 @@ def test_removed_volume_and_plastic_work_are_the_profiles(offset_run, model):
     _, liner = offset_run
     s = liner.summary()
     assert s["volume"] == pytest.approx(np.sum(liner.profile) * liner.cell_area, rel=1e-12)
-    assert s["plastic_work"] == pytest.approx(np.sum(FY * liner.depth), rel=1e-9)
+    # the law is a tip's: the work is the yield pressure F_y / A_tip times the volume
+    assert s["plastic_work"] == pytest.approx(FY / liner.tip_area * s["volume"], rel=1e-9)
     assert s["depth_max"] == liner.depth.max()
     # 3D: two rows (LE, TE), each end carrying half the chord
     c = make_contact(model, "3D", g0=0.2e-3)
@@ -138,8 +139,25 @@ def test_removed_volume_and_plastic_work_are_the_profiles(offset_run, model):
     run_transient(model, c, 0.5 * model.params.normalisation.omega_ref, t_end=0.5, me=0.0, t_ramp=0.0, liner=l3)
     d = l3.depth
     assert d.max() > 0
-    assert l3.plastic_work == pytest.approx(0.5 * np.sum(FY * d + 0.5 * 2e5 * d**2), rel=1e-9)
+    w = l3.cell_area / l3.tip_area
+    assert l3.plastic_work == pytest.approx(0.5 * w * np.sum(FY * d + 0.5 * 2e5 * d**2), rel=1e-9)
     assert l3.summary()["volume"] == pytest.approx(d.mean(axis=0).sum() * l3.cell_area, rel=1e-12)
+
+
+def test_volume_and_work_converge_with_the_cells(model):
+    """The offset casing's wear with 360, 1440 and 2880 cells: volume and plastic work converge (measured:
+    1.1 % from 360 to 2880 cells, 0.014 % from 1440), so the work is the liner's, not its discretisation's."""
+    out = {}
+    for ns in (360, 1440, 2880):
+        c = make_contact(model, "2D", g0=0.2e-3)
+        liner = Liner.for_model(model, c, wears=True, offset=(0.3e-3, 0.0), n_sectors=ns)
+        run_transient(model, c, 0.5 * model.params.normalisation.omega_ref, t_end=1.0, me=0.0, t_ramp=0.0,
+                      liner=liner)
+        out[ns] = liner.summary()
+    for key in ("volume", "plastic_work"):
+        coarse, fine, finest = (out[ns][key] for ns in (360, 1440, 2880))
+        assert abs(fine - finest) < 1e-3 * finest and abs(coarse - finest) < 2e-2 * finest
+        assert abs(fine - finest) < 0.1 * abs(coarse - finest)
 
 
 def _stationary_backward_wave(model, h):
@@ -226,3 +244,22 @@ def test_the_kernels_constants_are_the_librarys_and_the_interfaces():
     assert f"#define RR_WEAR_HARMONICS {kernel.WEAR_HARMONICS} " in header
     assert interface.WEAR_HARMONICS == kernel.WEAR_HARMONICS
     assert f"#define RR_ABI_VERSION {kernel.ABI_VERSION}" in header
+
+
+def test_the_wear_command_writes_its_figures_and_refuses_bad_inputs(tmp_path, capsys):
+    import json
+
+    from rotorub_model.app.cli import main
+
+    out = tmp_path / "wear"
+    assert main(["wear", "--speed", "3.3", "--g0", "0.335e-3", "--t-end", "3", "--offset-x", "0.2e-3",
+                 "--out", str(out)]) == 0
+    capsys.readouterr()
+    for f in ("2D", "3D"):
+        s = json.loads((out / f / "wear.json").read_text())
+        assert s["casing_offset_mm"] == [0.2, 0.0] and s["depth_max_mm"] > 0
+        for png in ("wear_map.png", "wear_profile.png", "forces.png"):
+            assert (out / f / png).stat().st_size > 10_000
+    assert main(["wear", "--closure", "0.5", "--out", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err
+    assert "--closure" in err and "[-0.01, 0.01] m" in err

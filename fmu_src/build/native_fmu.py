@@ -126,7 +126,8 @@ def contact_model_data(model, variables: list[interface.Var]) -> str:
         f"VR_THICKNESS = {vr['liner_thickness']}, VR_N_SECTORS = {vr['n_sectors']}, "
         f"VR_CLOSURE = {vr['clearance_closure']}, VR_OFFSET_X = {vr['casing_offset.x']}, "
         f"VR_OFFSET_Y = {vr['casing_offset.y']}, VR_CLEARANCE_EFFECTIVE = {vr['clearance_effective']};",
-        f"const int WEAR_INDEX[{len(wear)}] = {{{', '.join(map(str, wear))}}};", "",
+        f"const int WEAR_INDEX[{len(wear)}] = {{{', '.join(map(str, wear))}}};",
+        f"const double BLADE_THICKNESS = {_c_double(model.params.blades.thickness)};", "",
     ]
     for key in ("M", "D", "K", "G1", "C1", "N2", "S2", "f_unit"):
         out.append(_array(key, getattr(model, key).ravel()))

@@ -251,6 +251,8 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
         m->surf.yield_force = v->r[VR_YIELD];
         m->surf.hardening = v->r[VR_HARDENING];
         m->surf.thickness = v->r[VR_THICKNESS];
+        m->cell_area = d->r_tip * (6.283185307179586476925286766559 / ns) * (m->chord * rr_cos(d->stagger));
+        m->surf.work_weight = m->cell_area / (BLADE_THICKNESS * m->chord);
         m->surf_mem = (double *)zalloc((size_t)rr_surface_table_size(nb, np, ns) + (size_t)np * ns, sizeof(double));
         if (!m->surf_mem) goto oom;
         m->surf.tables = m->surf_mem;
@@ -261,7 +263,6 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
             model_free(m);
             return NULL;
         }
-        m->cell_area = d->r_tip * (6.283185307179586476925286766559 / ns) * (m->chord * rr_cos(d->stagger));
         if (m->mode == MODE_TRANSIENT) m->contact.surface = &m->surf;
     }
     return m;

@@ -37,6 +37,7 @@ extern const int VR_LINER, VR_YIELD, VR_HARDENING, VR_THICKNESS, VR_N_SECTORS, V
     VR_CLEARANCE_EFFECTIVE;
 /* where rr_surface_summary's RR_WEAR_OUT values go (RR_WEAR_LOBES: the Integer array) */
 extern const int WEAR_INDEX[];
+extern const double BLADE_THICKNESS; /* [m]: a tip's footprint on the liner is this x the chord */
 /* where the kernel's outputs of a state (its order, RR_N_OUT(nb)) go in the Real value array */
 extern const int OUTPUT_INDEX[];
 

@@ -365,7 +365,8 @@ class RotorCasingContact(Fmi2Slave):
         sim["liner"] = lib.liner.Liner(contact, cfg["yield_force"], cfg["hardening"], cfg["liner_thickness"],
                                        int(cfg["n_sectors"]), wears=cfg["liner"] == "abradable",
                                        radius=params.blades.tip_radius,
-                                       band=cfg["chord"] * math.cos(math.radians(params.blades.stagger_deg)))
+                                       band=cfg["chord"] * math.cos(math.radians(params.blades.stagger_deg)),
+                                       tip_area=params.blades.thickness * cfg["chord"])
         if sim["transient"]:
             sim["cd"] = lib.transient.CentralDifference(model, contact, dt=None, t_ramp=0.0,
                                                         max_penetration=cfg["max_penetration"],

@@ -15,6 +15,9 @@ FIGURES = [
     ("Detection vs chord length (paper Fig. 9)", "detection/detection_chord.png"),
     ("Static solutions and their stability, 2D and 3D (paper Fig. 10-11)", "stability/stability_maps.png"),
     ("Normal contact forces per blade, 2D vs 3D transient (paper Fig. 12)", "transient/contact_forces.png"),
+    ("Wear map: the same rub against an abradable liner, 3D (depth over angle and time)", "wear/3D/wear_map.png"),
+    ("Worn profile after the rub, 3D: unrolled, polar, spectrum", "wear/3D/wear_profile.png"),
+    ("Worn profile after the rub, 2D", "wear/2D/wear_profile.png"),
     ("Continuation: static branches, special points and periodic orbits at the section-6 speed",
      "continuation/continuation.png"),
     ("Stability boundary by continuation over the grid maps", "continuation/boundaries.png"),
@@ -228,6 +231,23 @@ def _fmu_section(summary: dict) -> list[str]:
     return lines
 
 
+def _wear_section(w: dict) -> list[str]:
+    lines = ["", "## The section-6 rub against an abradable liner", "",
+             f"Not in the paper (its casing is rigid): the same transient at Ω = {w['speed']:.4g}, g0 = "
+             f"{w['g0_mm']:.4g} mm against the parameter file's liner, worn (docs/THEORY.md, \"Abradable liner\").",
+             "", "| formulation | deepest wear | mean wear | volume removed | plastic work | lobes | clearance "
+             "before → after |", "|---|---|---|---|---|---|---|"]
+    for f in ("2D", "3D"):
+        s = w.get(f)
+        if not s:
+            continue
+        lobes = s["lobes"] if s["lobes"] else "none (worn evenly: a 360° rub)"
+        lines.append(f"| {f} | {s['depth_max_mm'] * 1e3:.1f} µm | {s['depth_mean_mm'] * 1e3:.1f} µm | "
+                     f"{s['removed_volume_mm3']:.4g} mm³ | {s['plastic_work_J']:.4g} J | {lobes} | "
+                     f"{s['clearance_before_mm']:.4g} → {s['clearance_effective_mm']:.4g} mm |")
+    return lines
+
+
 def _continuation_section(c: dict) -> list[str]:
     lines = ["", "## Continuation: special points, what the instability grows into, the boundary as a curve", "",
              "Static branches in g0 at the section-6 speed (pseudo-arclength through contact events), their Hopf, "
@@ -291,6 +311,8 @@ def write_report(out: str | Path, summary: dict) -> Path:
         lines.append("Every fact holds on this configuration.")
     for f in failing:
         lines.append(f"* Fact {f['id']}: {f.get('why', 'see the values in the table and docs/THEORY.md')}")
+    if "wear" in summary:
+        lines += _wear_section(summary["wear"])
     if "continuation" in summary:
         lines += _continuation_section(summary["continuation"])
     if "blade_discretisation" in summary:

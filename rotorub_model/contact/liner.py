@@ -11,9 +11,12 @@ time step (the kernel's ``rr_liner_law``):
     F <= F_y + H w                                yield, with linear hardening H,
     dw = (F - F_y - H w) / (k_r + H) > 0          removal when the bound is exceeded (w <= thickness),
 
-so a tip pushed to an incursion delta removes exactly delta - F_y / k_r without hardening, and the work
-dissipated is the integral of F_y + H w over the removed depth. In 3D each end point carries half the
-chord (k_r / 2, F_y / 2, H / 2). Only the time loop cuts the liner; the static analyses see no liner.
+so a tip pushed to an incursion delta removes exactly delta - F_y / k_r without hardening. The law is a
+blade tip's; the work dissipated in a cell is the law's (the integral of F_y + H w over the removed depth)
+times the cell's area over the tip's footprint (blade thickness x chord): the liner's yield pressure
+F_y / A_tip (with its hardening) times the volume removed, whatever the cells' count. In 3D each end
+point carries half the chord (k_r / 2, F_y / 2, H / 2). Only the time loop cuts the liner; the static
+analyses see no liner.
 docs/THEORY.md ("Abradable liner") gives the reading of the literature behind this choice.
 """
 
@@ -50,6 +53,8 @@ class Liner:
     offset: tuple[float, float] = (0.0, 0.0)
     radius: float = 1.0  # of the casing at the tips [m] (volumes and areas)
     band: float = 0.14  # axial width of the band the tips sweep [m] (the chord's axial extent)
+    tip_area: float = 2.2e-3  # a blade tip's footprint on the liner [m^2] (thickness x chord): F_y over it is
+    # the liner's yield pressure, and the plastic work the yield pressure times the volume removed
     depth: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
@@ -57,7 +62,8 @@ class Liner:
                                  ("hardening", self.hardening, self.hardening >= 0, "[0, inf) N/m"),
                                  ("thickness", self.thickness, self.thickness > 0, "(0, inf) m"),
                                  ("radius", self.radius, self.radius > 0, "(0, inf) m"),
-                                 ("band", self.band, self.band > 0, "(0, inf) m")):
+                                 ("band", self.band, self.band > 0, "(0, inf) m"),
+                                 ("tip_area", self.tip_area, self.tip_area > 0, "(0, inf) m^2")):
             if not (math.isfinite(v) and ok):
                 raise ParameterError(f"liner {name}: {v!r} out of range; accepted range {rng}")
         if not (isinstance(self.n_sectors, int | np.integer) and 8 <= self.n_sectors <= 100000):
@@ -69,7 +75,7 @@ class Liner:
         self.struct = kernel.RRSurface(n_sectors=int(self.n_sectors), wears=int(bool(self.wears)),
                                        yield_force=float(self.yield_force), hardening=float(self.hardening),
                                        thickness=float(self.thickness), tables=kernel.ptr(self._tables),
-                                       depth=kernel.ptr(self.depth))
+                                       depth=kernel.ptr(self.depth), work_weight=self.cell_area / self.tip_area)
         self.set_inputs(self.closure, self.offset)
         if lib.rr_surface_init(c.kernel, ctypes.byref(self.struct)) != 0:
             raise ParameterError("liner: the kernel refused its parameters")
@@ -82,7 +88,8 @@ class Liner:
         a = p.abradable
         kw = {"yield_force": a.yield_force, "hardening": a.hardening, "thickness": a.thickness,
               "n_sectors": a.n_sectors, "radius": p.blades.tip_radius,
-              "band": p.contact.chord * math.cos(math.radians(p.blades.stagger_deg)), **overrides}
+              "band": p.contact.chord * math.cos(math.radians(p.blades.stagger_deg)),
+              "tip_area": p.blades.thickness * p.contact.chord, **overrides}
         return cls(contact, wears=a.enabled if wears is None else bool(wears), **kw)
 
     def set_inputs(self, closure: float | None = None, offset: tuple[float, float] | None = None) -> None:

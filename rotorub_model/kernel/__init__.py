@@ -57,7 +57,8 @@ class RRSurface(ctypes.Structure):
     _fields_ = [("n_sectors", ctypes.c_int), ("wears", ctypes.c_int), ("yield_force", ctypes.c_double),
                 ("hardening", ctypes.c_double), ("thickness", ctypes.c_double), ("closure", ctypes.c_double),
                 ("offset_x", ctypes.c_double), ("offset_y", ctypes.c_double), ("phi", ctypes.c_double),
-                ("plastic_work", ctypes.c_double), ("changed", ctypes.c_int), ("tables", _dp), ("depth", _dp)]
+                ("work_weight", ctypes.c_double), ("plastic_work", ctypes.c_double), ("changed", ctypes.c_int),
+                ("tables", _dp), ("depth", _dp)]
 
 
 WEAR_HARMONICS = 8

@@ -487,6 +487,7 @@ int rr_surface_init(const rr_contact *c, rr_surface *s)
     int k, h, m, rows = c->nb * c->np, ns = s->n_sectors;
     double *a0, *ca, *sa, *nr, *bc, *bs;
     if (!(ns >= 8 && ns <= 1000000) || !(s->yield_force > 0.0) || !(s->hardening >= 0.0) || !(s->thickness > 0.0) ||
+        !(s->work_weight > 0.0) ||
         !(s->closure == s->closure) || !(s->offset_x == s->offset_x) || !(s->offset_y == s->offset_y) ||
         !s->tables || !s->depth)
         return -1;
@@ -611,7 +612,9 @@ static void surface_cut(const rr_contact *c, const double *gaps, double phi_new)
             int cell = ((c0 + step * j) % ns + ns) % ns;
             double gc = offset ? g + nr[k] * (s->offset_x * bc[cell] + s->offset_y * bs[cell]) : g;
             if (gc + row[cell] < 0.0 && kp * -(gc + row[cell]) > fy + hp * row[cell]) {
-                liner_law(gc, kp, fy, hp, s->thickness, 1, row + cell, &s->plastic_work);
+                double work = 0.0;
+                liner_law(gc, kp, fy, hp, s->thickness, 1, row + cell, &work);
+                s->plastic_work += s->work_weight * work;
                 s->changed = 1;
             }
         }

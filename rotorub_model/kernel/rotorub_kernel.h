@@ -105,6 +105,9 @@ typedef struct {
     double offset_x;     /* rigid offset of the casing centre, fixed frame [m] (engine input) */
     double offset_y;
     double phi;          /* frame angle of the state the gaps are evaluated at; the time loop keeps it [rad] */
+    double work_weight;  /* a cell's area over a blade tip's (the law is a tip's): the plastic work per cell is
+                          * the law's times this, so that it is the yield pressure times the volume, whatever
+                          * the cells' count (> 0) */
     double plastic_work; /* work dissipated in removing the liner since the start [J] (state) */
     int changed;         /* set when a cell is cut (a summary clears nothing: for the caller) */
     double *tables;      /* rr_surface_table_size(nb, np, n_sectors) doubles, filled by rr_surface_init */
