@@ -413,6 +413,33 @@ def reference_parameters() -> Parameters:
     return _REFERENCE
 
 
+def _toml_value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        return repr(v)  # the shortest decimal that reads back to the same double; valid TOML
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, list | tuple):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    raise TypeError(f"no TOML form for {v!r}")
+
+
+def to_toml(p: Parameters) -> str:
+    """The parameters as a TOML parameter file (what :func:`load_parameters` reads back to the same values)."""
+    d = to_dict(p)
+    lines = ["# rotorub parameter file (SI units), written by rotorub_model.structure.params.to_toml", ""]
+    for sec, val in d.items():
+        if isinstance(val, list):
+            for item in val:
+                lines += [f"[[{sec}]]", *(f"{k} = {_toml_value(v)}" for k, v in item.items()), ""]
+        else:
+            lines += [f"[{sec}]", *(f"{k} = {_toml_value(v)}" for k, v in val.items()), ""]
+    return "\n".join(lines)
+
+
 def to_dict(p: Parameters) -> dict[str, Any]:
     """Nested plain-dict form of the parameters (round-trips through :func:`from_dict`)."""
     out: dict[str, Any] = {}
