@@ -171,9 +171,9 @@ class AbradableParams:
                                                           "paper: false, a rigid casing)", "bool": True})
     yield_force: float = _f(0, lo_open=True, default=100.0,
                             doc="a blade tip's normal force at which the liner starts to be removed [N] (a 3D "
-                                "chord pressed uniformly yields at the same total force); default: the order "
-                                "of the normal forces of high-speed incursion tests into aluminium-polyester "
-                                "abradables at 0.1 mm depth of cut (tens to hundreds of N per blade)")
+                                "chord pressed uniformly yields at the same total force); default: of the order "
+                                "of the reference rub's own forces, so that it wears (docs/THEORY.md 4.1); a "
+                                "coating's crushing strength times the tip's footprint for a given liner")
     hardening: float = _f(0, default=0.0, doc="linear hardening: yield force gained per metre removed [N/m] "
                                                "(0: perfectly plastic)")
     thickness: float = _f(0, 0.05, lo_open=True, default=2.0e-3,
