@@ -33,6 +33,8 @@ ENUMERATIONS = {
                     ("3D", "leading and trailing edges facing a conical casing, pressure along the chord (eq. 3-8)")),
     "Mode": (("transient", "explicit central differences, substeps inside each communication step"),
              ("quasi_static", "the balanced static solution at the held inputs, with its stability")),
+    "Liner": (("rigid", "the paper's casing: rigid, never worn"),
+              ("abradable", "an abradable liner, cut where a blade tip presses it beyond its yield force")),
 }
 
 # unit -> (SI base-unit exponents, display units {name: factor}); display value = factor * value
@@ -47,6 +49,8 @@ UNITS: dict[str, tuple[dict[str, int], dict[str, float]]] = {
     "N": ({"kg": 1, "m": 1, "s": -2}, {"kN": 1e-3}),
     "N.m": ({"kg": 1, "m": 2, "s": -2}, {}),
     "1/s": ({"s": -1}, {}),
+    "m3": ({"m": 3}, {"mm3": 1e9}),
+    "J": ({"kg": 1, "m": 2, "s": -2}, {}),
     "1": ({}, {}),
 }
 
@@ -97,6 +101,11 @@ class Defaults:
     chord: float  # [m]
     max_penetration: float  # [m]
     slip_velocity: float  # [m/s]
+    liner: bool = False  # the parameter file's abradable.enabled
+    yield_force: float = 100.0  # [N]
+    hardening: float = 0.0  # [N/m]
+    liner_thickness: float = 2.0e-3  # [m]
+    n_sectors: int = 720
 
     @classmethod
     def from_parameters(cls, p) -> Defaults:
@@ -105,7 +114,9 @@ class Defaults:
                    omega_max=p.normalisation.speed_max * p.normalisation.omega_ref, me=p.imbalance.me,
                    me_max=b.mass * (b.hub_radius + 0.5 * b.length), g0=p.contact.g0, k_r=p.contact.k_r,
                    mu=p.contact.mu, theta=math.radians(p.contact.theta_deg), chord=p.contact.chord,
-                   max_penetration=p.contact.max_penetration, slip_velocity=p.contact.slip_velocity)
+                   max_penetration=p.contact.max_penetration, slip_velocity=p.contact.slip_velocity,
+                   liner=p.abradable.enabled, yield_force=p.abradable.yield_force, hardening=p.abradable.hardening,
+                   liner_thickness=p.abradable.thickness, n_sectors=p.abradable.n_sectors)
 
 
 # ranges that are modelling judgements (the descriptions say why); g0's lower end is the built-in
@@ -118,6 +129,13 @@ CHORD_RANGE = (1e-3, 0.5)
 DT_MAX_RANGE = (1e-8, 1.0)
 PENETRATION_RANGE = (1e-5, 0.05)
 SLIP_RANGE = (1e-4, 10.0)
+CLOSURE_RANGE = (-0.01, 0.01)  # +-10 mm: an engine's thermal and centrifugal growth, with margin
+OFFSET_RANGE = (-0.01, 0.01)
+YIELD_RANGE = (1e-3, 1e7)
+HARDENING_RANGE = (0.0, 1e10)
+THICKNESS_RANGE = (1e-5, 0.05)
+SECTORS_RANGE = (8, 100000)
+WEAR_HARMONICS = 8  # the kernel's RR_WEAR_HARMONICS
 
 
 # the default experiment (both flavours): the paper's section-6 speed and the reference imbalance held from t = 0,
@@ -227,6 +245,49 @@ def variables(d: Defaults, mode: str = "transient", flavour: str = "native") -> 
             display_unit="ms"))
     add(Var("n_substeps", "Integer", "output", "discrete",
             "Internal steps taken in the last communication step (transient mode)"))
+    # the casing's liner and the engine's inputs on the casing (issue 19): after every earlier variable, so
+    # that their value references, and the connections of older systems, stay as they were
+    add(Var("liner", "Enumeration", "parameter", "fixed",
+            "The casing's inner surface: rigid (the paper's) or an abradable liner that wears (transient mode)",
+            start=2 if d.liner else 1, min=1, max=2, declared_type="Liner"))
+    add(Var("yield_force", "Real", "parameter", "fixed",
+            "Liner: a blade tip's normal force at which the liner starts to be removed (a 3D chord pressed "
+            "uniformly yields at the same total force); below it the liner is elastic (the penalty k_r)",
+            unit="N", start=d.yield_force, min=YIELD_RANGE[0], max=YIELD_RANGE[1], nominal=100.0))
+    add(Var("hardening", "Real", "parameter", "fixed",
+            "Liner: linear hardening, yield force gained per metre removed (0: perfectly plastic)", unit="N/m",
+            start=d.hardening, min=HARDENING_RANGE[0], max=HARDENING_RANGE[1], nominal=1e5))
+    add(Var("liner_thickness", "Real", "parameter", "fixed",
+            "Liner thickness: no wear beyond it (the casing's substrate)", unit="m", display_unit="mm",
+            start=d.liner_thickness, min=THICKNESS_RANGE[0], max=THICKNESS_RANGE[1], nominal=2e-3))
+    add(Var("n_sectors", "Integer", "parameter", "fixed",
+            "Liner: cells over the circumference (fixed frame) that each carry a worn depth", start=d.n_sectors,
+            min=SECTORS_RANGE[0], max=SECTORS_RANGE[1]))
+    add(Var("clearance_closure", "Real", "input", "continuous",
+            "Closure of the tip clearance from the engine (thermal and centrifugal growth), uniform around the "
+            "casing, held over each step (> 0 closes; quasi_static mode: subtracted from g0)", unit="m",
+            display_unit="mm", start=0.0, min=CLOSURE_RANGE[0], max=CLOSURE_RANGE[1], nominal=1e-4))
+    for ax in "xy":
+        add(Var(f"casing_offset.{ax}", "Real", "input", "continuous",
+                f"Rigid offset of the casing centre from a carcass or manoeuvre-load model, fixed frame, {ax} "
+                "component, held over each step (transient mode; the gap opens where the offset points)", unit="m",
+                display_unit="mm", start=0.0, min=OFFSET_RANGE[0], max=OFFSET_RANGE[1], nominal=1e-4))
+    add(Var("wear.depth_max", "Real", "output", "discrete", "Deepest worn point of the liner", unit="m",
+            display_unit="mm"))
+    add(Var("wear.depth_mean", "Real", "output", "discrete",
+            "Mean worn depth around the casing (3D: also over the chord)", unit="m", display_unit="mm"))
+    add(Var("wear.volume", "Real", "output", "discrete", "Liner volume removed", unit="m3", display_unit="mm3"))
+    add(Var("wear.plastic_work", "Real", "output", "discrete", "Work dissipated in removing the liner",
+            unit="J"))
+    add(Var("wear.lobes", "Integer", "output", "discrete",
+            "Dominant lobe count of the worn profile: the harmonic 1-8 of largest amplitude (0: no wear, or worn "
+            "evenly: no harmonic reaches 1 % of the mean depth)"))
+    for h in range(1, WEAR_HARMONICS + 1):
+        add(Var(f"wear.harmonic[{h}]", "Real", "output", "discrete",
+                f"Amplitude of the worn profile's harmonic {h} ({h} lobes)", unit="m", display_unit="mm"))
+    add(Var("clearance_effective", "Real", "output", "discrete",
+            "Clearance the engine keeps: g0 - clearance_closure + the mean worn depth (what a performance model "
+            "pays for)", unit="m", display_unit="mm"))
     V = [replace(v, vr=k) for k, v in enumerate(V)]
     return [v for v in V if flavour == "pythonfmu" or v.name != "param_file"]
 
@@ -325,7 +386,10 @@ def model_description(vars_: list[Var], *, guid: str, generation_tool: str, vers
             t.set("start", v.start if isinstance(v.start, str) else _fmt(v.start))
     ms = SubElement(root, "ModelStructure")
     outs = SubElement(ms, "Outputs")
-    inputs = [str(i + 1) for i, v in enumerate(vars_) if v.causality == "input"]
+    # the quasi_static solution depends on the inputs but the casing's offset (a transient-mode input: a
+    # balanced solution of the rotating frame cannot hold a casing offset fixed in the other frame)
+    inputs = [str(i + 1) for i, v in enumerate(vars_)
+              if v.causality == "input" and not v.name.startswith("casing_offset")]
     for i, v in enumerate(vars_):
         if v.causality == "output":
             attrs = {"index": str(i + 1)}

@@ -97,3 +97,20 @@ def test_parameter_source_of_a_file(write_params, ref_params):
     assert parameter_source(build_model(), path)["file_matches_model"] is False
     mem = parameter_source(stiff)  # no file: only the values identify the configuration
     assert mem["absolute_path"] is None and mem["sha256"] == mem["values_sha256"] == src["values_sha256"]
+
+
+def test_main_job_wears_the_liner_at_the_transient_point(run):
+    """The section-6 rub against the parameter file's abradable liner: both formulations wear it, evenly (a
+    synchronous whirl's 360-degree rub: no lobes), the clearance opens by the mean depth, and the report says so
+    next to the wear figures."""
+    out, summary = run
+    w = summary["wear"]
+    assert (w["speed"], w["g0_mm"]) == (summary["transient"]["speed"], summary["transient"]["g0_mm"])
+    for f in ("2D", "3D"):
+        s = w[f]
+        assert s["depth_max_mm"] > 0.01 and s["removed_volume_mm3"] > 0 and s["plastic_work_J"] > 0
+        assert s["clearance_effective_mm"] == pytest.approx(s["clearance_before_mm"] + s["depth_mean_mm"], rel=1e-9)
+        assert s["lobes"] == 0
+        assert (out / "wear" / f / "wear_profile.png").exists() and (out / "wear" / f / "wear_map.png").exists()
+    text = (out / "report.md").read_text()
+    assert "against an abradable liner" in text and "wear/3D/wear_map.png" in text

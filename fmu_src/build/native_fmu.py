@@ -116,10 +116,18 @@ def contact_model_data(model, variables: list[interface.Var]) -> str:
     index = [vr[f"blade[{j}].{b}"] for b in kernel.OUT_BLADE_NAMES for j in range(1, nb + 1)]
     index += [vr[g] for g in kernel.OUT_GLOBAL_NAMES]
     spec = geometry_spec(model, 2, 0.0, 0.0, True)
+    wear = [vr[f"wear.{k}"] for k in ("depth_max", "depth_mean", "volume", "plastic_work", "lobes")]
+    wear += [vr[f"wear.harmonic[{h}]"] for h in range(1, interface.WEAR_HARMONICS + 1)]
     out = [
         f"const int VR_N_CONTACT = {vr['n_contact']}, VR_MAX_REAL = {vr['max_real_eig']}, "
         f"VR_DT_INTERNAL = {vr['dt_internal']}, VR_N_SUBSTEPS = {vr['n_substeps']};",
-        f"const int OUTPUT_INDEX[{len(index)}] = {{{', '.join(map(str, index))}}};", "",
+        f"const int OUTPUT_INDEX[{len(index)}] = {{{', '.join(map(str, index))}}};",
+        f"const int VR_LINER = {vr['liner']}, VR_YIELD = {vr['yield_force']}, VR_HARDENING = {vr['hardening']}, "
+        f"VR_THICKNESS = {vr['liner_thickness']}, VR_N_SECTORS = {vr['n_sectors']}, "
+        f"VR_CLOSURE = {vr['clearance_closure']}, VR_OFFSET_X = {vr['casing_offset.x']}, "
+        f"VR_OFFSET_Y = {vr['casing_offset.y']}, VR_CLEARANCE_EFFECTIVE = {vr['clearance_effective']};",
+        f"const int WEAR_INDEX[{len(wear)}] = {{{', '.join(map(str, wear))}}};",
+        f"const double BLADE_THICKNESS = {_c_double(model.params.blades.thickness)};", "",
     ]
     for key in ("M", "D", "K", "G1", "C1", "N2", "S2", "f_unit"):
         out.append(_array(key, getattr(model, key).ravel()))

@@ -28,6 +28,7 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
+from .clearance_interface import MODEL_IDENTIFIER as CLEARANCE_ID
 from .system import (
     CONNECTIONS,
     CONTACT_ID,
@@ -113,7 +114,8 @@ def _xml_bytes(root: ET.Element) -> bytes:
 def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, *, g0: float = G0_RUB,
               imbalance: float = ME_REF, formulation: str = "3D", mode: str = "transient",
               spool_params: dict | None = None, contact_params: dict | None = None, t_end: float = 5.0,
-              h: float = 1e-3, name: str = "RotorRubEngine") -> Path:
+              h: float = 1e-3, name: str = "RotorRubEngine", clearance_fmu: str | Path | None = None,
+              clearance_params: dict | None = None) -> Path:
     """Write the coupled system as an SSP 1.0 package; returns its path.
 
     The package holds ``SystemStructure.ssd``, ``resources/RotorCasingContact.fmu``,
@@ -122,15 +124,27 @@ def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, 
     ``resources/spool.ssv`` (the spool FMU's parameter start values updated by
     ``spool_params``). The communication step and the exchange order of
     :func:`run_coupled` are recorded in an annotation of the default experiment.
+
+    With ``clearance_fmu`` (TipClearance.fmu, fmu_src/engine/clearance.py) a third component ``clearance``
+    turns the spool's speed into the clearance closure the contact gets (spool.Omega -> clearance.Omega,
+    clearance.closure -> contact.clearance_closure), with ``clearance_params`` in ``resources/clearance.ssv``;
+    the contact then also shows its wear outputs and the clearance it keeps.
     """
     path = Path(path)
     cvars, cunits, croot = read_description(contact_fmu)
     svars, sunits, _ = read_description(spool_fmu)
     all_units = {**sunits, **cunits}
-    for el, conn, _e, _c in CONNECTIONS:
-        vars_ = cvars if el == "contact" else svars
-        if conn not in vars_:
-            raise EngineError(f"write_ssp: the {el} FMU has no variable '{conn}'")
+    connections = list(CONNECTIONS)
+    if clearance_fmu is not None:
+        kvars, kunits, _ = read_description(clearance_fmu)
+        all_units = {**kunits, **all_units}
+        connections += [("spool", "Omega", "clearance", "Omega"), ("clearance", "closure", "contact",
+                                                                   "clearance_closure")]
+    for el, conn, ee, ec in connections:
+        for comp, var in ((el, conn), (ee, ec)):
+            vars_ = {"contact": cvars, "spool": svars}.get(comp) or kvars
+            if var not in vars_:
+                raise EngineError(f"write_ssp: the {comp} FMU has no variable '{var}'")
     spool_values = {k: float(v.start) for k, v in svars.items() if v.causality == "parameter"}
     for k, v in (spool_params or {}).items():
         if k not in spool_values:
@@ -157,14 +171,25 @@ def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, 
                       generationTool="rotorub fmu_src.engine.ssp")
     system = ET.SubElement(root, _q("ssd", "System"), name=name)
     elements = ET.SubElement(system, _q("ssd", "Elements"))
-    comps = (
+    comps = [
         ("contact", f"resources/{CONTACT_ID}.fmu", cvars, contact_values,
          [("Omega", "input"), ("imbalance", "input"), ("friction_torque", "output"), ("n_contact", "output"),
           ("gap_min", "output")]),
         ("spool", f"resources/{SPOOL_ID}.fmu", svars, spool_values,
          [("friction_torque", "input"), ("Omega", "output"), ("drive_torque", "output"),
           ("windage_torque", "output")]),
-    )
+    ]
+    if clearance_fmu is not None:
+        comps[0][4].extend([("clearance_closure", "input"), ("wear.depth_max", "output"),
+                            ("wear.volume", "output"), ("clearance_effective", "output")])
+        clearance_values = {k: float(v.start) for k, v in kvars.items() if v.causality == "parameter"}
+        for k, v in (clearance_params or {}).items():
+            if k not in clearance_values:
+                raise EngineError(f"write_ssp: clearance parameter '{k}' unknown; known: {', '.join(clearance_values)}")
+            clearance_values[k] = float(v)
+
+        comps.append(("clearance", f"resources/{CLEARANCE_ID}.fmu", kvars, clearance_values,
+                      [("Omega", "input"), ("closure", "output")]))
     for cname, source, vars_, pvalues, conns in comps:
         comp = ET.SubElement(elements, _q("ssd", "Component"), name=cname, type="application/x-fmu-sharedlibrary",
                              source=source, implementation="CoSimulation")
@@ -181,9 +206,9 @@ def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, 
         bindings = ET.SubElement(comp, _q("ssd", "ParameterBindings"))
         ET.SubElement(bindings, _q("ssd", "ParameterBinding"), type="application/x-ssp-parameter-set",
                       source=f"resources/{cname}.ssv")
-    connections = ET.SubElement(system, _q("ssd", "Connections"))
-    for se, sc, ee, ec in CONNECTIONS:
-        ET.SubElement(connections, _q("ssd", "Connection"), startElement=se, startConnector=sc, endElement=ee,
+    conn_el = ET.SubElement(system, _q("ssd", "Connections"))
+    for se, sc, ee, ec in connections:
+        ET.SubElement(conn_el, _q("ssd", "Connection"), startElement=se, startConnector=sc, endElement=ee,
                       endConnector=ec)
     # OMSimulator: the system is a fixed-step co-simulation (its "oms-ma" master), with our step
     oms = ET.SubElement(ET.SubElement(ET.SubElement(system, _q("ssd", "Annotations")), _q("ssc", "Annotation"),
@@ -220,6 +245,9 @@ def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, 
         z.write(spool_fmu, f"resources/{SPOOL_ID}.fmu")
         z.writestr("resources/contact.ssv", _parameter_set("contact", contact_values, cvars, all_units))
         z.writestr("resources/spool.ssv", _parameter_set("spool", spool_values, svars, all_units))
+        if clearance_fmu is not None:
+            z.write(clearance_fmu, f"resources/{CLEARANCE_ID}.fmu")
+            z.writestr("resources/clearance.ssv", _parameter_set("clearance", clearance_values, kvars, all_units))
     return path
 
 
@@ -374,17 +402,17 @@ def run_ssp_libcosim(ssp: str | Path, t_end: float, h: float = 1e-3,
     for comp, var in record:
         if comp not in index:
             raise EngineError(f"run_ssp_libcosim: no component '{comp}' in {ssp}")
-        names = {v.name.decode(): v.reference for v in ex.slave_variables(index[comp])}
+        names = {v.name.decode(): (v.reference, v.type) for v in ex.slave_variables(index[comp])}
         if var not in names:
             raise EngineError(f"run_ssp_libcosim: component '{comp}' has no variable '{var}'")
-        refs[f"{comp}.{var}"] = (index[comp], names[var])
+        refs[f"{comp}.{var}"] = (index[comp], *names[var])
     out = {k: np.empty(steps) for k in refs}
     for k in range(steps):
         if not ex.step(1):
             raise EngineError(f"run_ssp_libcosim: step {k} (t = {k * h:g} s) failed; libcosim state "
                               f"{ex.status().state}")
-        for key, (i, ref) in refs.items():
-            out[key][k] = observer.last_real_values(i, [ref])[0]
+        for key, (i, ref, typ) in refs.items():  # libcosim's variable types: 0 Real, 1 Integer
+            out[key][k] = (observer.last_integer_values if typ == 1 else observer.last_real_values)(i, [ref])[0]
     del ex, observer
     return {"t": (np.arange(steps) + 1) * h, **out}
 
@@ -417,7 +445,7 @@ def _ssp_model(z: zipfile.ZipFile, where: Path) -> dict:
                 else:
                     raise EngineError(f"run_ssp_native: {name}.{pname}: {kind} parameters are not supported")
         comps.append({"name": name, "dir": d, "model": froot.find("CoSimulation").get("modelIdentifier"),
-                      "vr": md_vr, "values": values})
+                      "vr": md_vr, "values": values, "types": {k: v.type for k, v in fvars.items()}})
     conns = [(c.get("startElement"), c.get("startConnector"), c.get("endElement"), c.get("endConnector"))
              for c in root.iter(_q("ssd", "Connection"))]
     steps = [float(el.get("stepSize")) for ns in (OMS_NS, MASTER_NS) for el in root.iter(f"{{{ns}}}FixedStepMaster")]
@@ -453,12 +481,73 @@ def run_ssp_native(ssp: str | Path, t_end: float, h: float | None = None,
         for comp, var in record:
             if comp not in by or var not in by[comp]["vr"]:
                 raise EngineError(f"run_ssp_native: no variable {comp}.{var} in {ssp}")
-            args += ["-o", f"{comp}:{by[comp]['vr'][var]}"]
+            flag = "-i" if by[comp]["types"].get(var) in ("Integer", "Enumeration") else "-o"
+            args += [flag, f"{comp}:{by[comp]['vr'][var]}"]
         proc = subprocess.run(args, capture_output=True, text=True, timeout=1800, env={"PATH": "/usr/bin:/bin"})
     if proc.returncode != 0:
         raise EngineError(f"run_ssp_native: engine_host exit status {proc.returncode}", proc.stderr.splitlines()[-5:])
-    _, rows = native_host.read_csv(proc.stdout)
+    head, rows = native_host.read_csv(proc.stdout)
     out = {"t": rows[1:, 0]}
-    for k, (comp, var) in enumerate(record):
-        out[f"{comp}.{var}"] = rows[1:, 1 + k]
+    for comp, var in record:  # the host's columns: NAME:rVR (reals) then NAME:iVR (integers)
+        kind = "i" if by[comp]["types"].get(var) in ("Integer", "Enumeration") else "r"
+        out[f"{comp}.{var}"] = rows[1:, head.index(f"{comp}:{kind}{by[comp]['vr'][var]}")]
     return out
+
+
+def run_ssp_fmpy(ssp: str | Path, t_end: float, h: float | None = None,
+                 record: tuple[tuple[str, str], ...] = (("spool", "Omega"), ("contact", "friction_torque"))
+                 ) -> dict[str, np.ndarray]:
+    """Run an SSP package as written with fmpy's FMU2Slave: every component, its bound parameter values set in
+    initialization mode, its connections, Jacobi exchange at a fixed step (the package's unless ``h`` is
+    given), as :func:`run_ssp_native` and libcosim do. Returns the time points after each step and the
+    recorded variables ("component.variable"); a refused step raises :class:`EngineError` with the FMUs'
+    messages."""
+    import tempfile
+
+    from fmpy.fmi1 import FMICallException
+
+    from ..harness.fmi_run import FMUError, Slave
+
+    with tempfile.TemporaryDirectory(prefix="rotorub_ssp_") as tmp, zipfile.ZipFile(ssp) as z:
+        m = _ssp_model(z, Path(tmp))
+        h = h or m["step"]
+        if not h:
+            raise EngineError(f"run_ssp_fmpy: {ssp} gives no communication step; pass h")
+        steps = int(round(t_end / h))
+        slaves: dict[str, Slave] = {}
+        try:
+            for c in m["components"]:
+                s = slaves[c["name"]] = Slave(c["dir"], instance_name=c["name"], unzip_dir=c["dir"], initialize=False)
+                f = s.fmu
+                f.setupExperiment(startTime=0.0, stopTime=t_end)
+                f.enterInitializationMode()
+                for flag, vr, v in c["values"]:
+                    (f.setReal if flag == "p" else f.setInteger)([vr], [v])
+                f.exitInitializationMode()
+            by = {c["name"]: c for c in m["components"]}
+            links = [(slaves[se].fmu, by[se]["vr"][sc], slaves[ee].fmu, by[ee]["vr"][ec])
+                     for se, sc, ee, ec in m["connections"]]
+            for comp, var in record:
+                if comp not in by or var not in by[comp]["vr"]:
+                    raise EngineError(f"run_ssp_fmpy: no variable {comp}.{var} in {ssp}")
+            probes = [(slaves[comp].fmu, by[comp]["vr"][var], slaves[comp].variables[var].type)
+                      for comp, var in record]
+            out = np.empty((steps, len(record)))
+            for k in range(steps):
+                values = [src.getReal([vr])[0] for src, vr, _d, _v in links]  # Jacobi: every output at t_k first
+                for (_s, _vr, dst, dvr), v in zip(links, values):
+                    dst.setReal([dvr], [v])
+                try:
+                    for s in slaves.values():
+                        s.fmu.doStep(currentCommunicationPoint=k * h, communicationStepSize=h)
+                except FMICallException as exc:
+                    msgs = [f"{n}: {msg}" for n, s in slaves.items() for msg in s.log.problems(0)]
+                    raise EngineError(f"run_ssp_fmpy: step at t = {k * h:g} s refused ({exc})", msgs) from None
+                for j, (f, vr, typ) in enumerate(probes):
+                    out[k, j] = f.getReal([vr])[0] if typ == "Real" else f.getInteger([vr])[0]
+        except FMUError as exc:
+            raise EngineError(f"run_ssp_fmpy: {exc}", exc.messages) from None
+        finally:
+            for s in slaves.values():
+                s.close()
+    return {"t": (np.arange(steps) + 1) * h, **{f"{c}.{v}": out[:, j] for j, (c, v) in enumerate(record)}}

@@ -79,11 +79,18 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
     _step("coupled engine scenario: LP spool FMU + contact FMU, fmpy master loop, SSP file")
     coupled = run_coupled_scenario(out / "coupled", quick=quick, contact_fmu=fmu, fmu_dir=fmu_dir)
     res["coupled_run"] = coupled
+    from ..engine.wear_scenario import run_wear_scenario
+
+    _step("engine scenario with wear: spool + clearance closure + contact with its abradable liner (SSP, three "
+          "masters)")
+    wear = run_wear_scenario(out / "coupled_wear", quick=quick, fmu_dir=Path(fmu_dir) / "wear" if fmu_dir else None)
+    res["coupled_wear_run"] = {k: v for k, v in wear.items() if k != "figures"}
     res["figures_extra"] = [
         ("Contact and stability maps through the FMU (quasi-static sweeps)", "fmu_quasi_static/fmu_maps.png"),
         ("Normal contact forces through the FMU, 2D vs 3D (paper Fig. 12)", "fmu_transient/fmu_contact_forces.png"),
         ("Run-up through the first critical speed through the FMU", "fmu_run_up/run_up.png"),
         *[(t, str(Path("coupled") / p)) for t, p in coupled.get("figures", [])],
+        *[(t, str(Path("coupled_wear") / p)) for t, p in wear.get("figures", [])],
     ]
     return res
 

@@ -43,6 +43,10 @@ struct model_runtime {
     int have_qs;
     double phi_qs;
     double advanced;
+    /* the casing's surface (transient mode): the liner's cells and the engine's inputs */
+    rr_surface surf;
+    double *surf_mem;
+    double cell_area; /* m^2: arc at the tip radius times the band the tips sweep (chord cos stagger) */
 };
 
 static void *zalloc(size_t n, size_t size) { return calloc(n ? n : 1, size); }
@@ -56,6 +60,7 @@ void model_free(model_runtime *m)
     free(m->piv);
     free(m->qs);
     free(m->siwork);
+    free(m->surf_mem);
     free(m);
 }
 
@@ -76,6 +81,7 @@ static double critical_step(model_runtime *m, double w)
     double *Kc = m->Kw, *P = m->Aeig, *J = m->swork, *zero = m->Fw, big = 0.0;
     rr_contact closed = m->contact;
     closed.g0 = -1.0;
+    closed.surface = NULL; /* every blade closed: the surface changes nothing the limit sees */
     for (i = 0; i < n; ++i) zero[i] = 0.0;
     rr_jacobian(&closed, zero, NULL, w, J, NULL);
     k_omega(d, w, Kc);
@@ -237,6 +243,28 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
     m->job.rec_every = 1;
     m->job.rec_cap = 0;
     m->job.out_index = OUTPUT_INDEX;
+    /* the casing's surface: the liner (worn or rigid) and the engine's closure and offset, read at every step */
+    {
+        int ns = v->i[VR_N_SECTORS];
+        m->surf.n_sectors = ns;
+        m->surf.wears = v->i[VR_LINER] == LINER_ABRADABLE;
+        m->surf.yield_force = v->r[VR_YIELD];
+        m->surf.hardening = v->r[VR_HARDENING];
+        m->surf.thickness = v->r[VR_THICKNESS];
+        m->cell_area = d->r_tip * (6.283185307179586476925286766559 / ns) * (m->chord * rr_cos(d->stagger));
+        m->surf.work_weight = m->cell_area / (BLADE_THICKNESS * m->chord);
+        m->surf_mem = (double *)zalloc((size_t)rr_surface_table_size(nb, np, ns) + (size_t)np * ns, sizeof(double));
+        if (!m->surf_mem) goto oom;
+        m->surf.tables = m->surf_mem;
+        m->surf.depth = m->surf_mem + rr_surface_table_size(nb, np, ns);
+        if (rr_surface_init(&m->contact, &m->surf) != 0) {
+            snprintf(msg, len, "liner: the kernel refused its parameters (n_sectors %d, yield_force %g N, "
+                     "liner_thickness %g m)", ns, m->surf.yield_force, m->surf.thickness);
+            model_free(m);
+            return NULL;
+        }
+        if (m->mode == MODE_TRANSIENT) m->contact.surface = &m->surf;
+    }
     return m;
 oom:
     snprintf(msg, len, "out of memory");
@@ -290,6 +318,22 @@ static int substeps(model_runtime *m, double w, double h, char *msg, size_t len)
     return m->plan_n;
 }
 
+/* the liner's summary and the clearance the engine keeps, into the outputs */
+static void wear_outputs(const model_runtime *m, model_values *v)
+{
+    double out[RR_WEAR_OUT];
+    int k;
+    double closure = v->r[VR_CLOSURE];
+    rr_surface_summary(&m->contact, &m->surf, m->cell_area, out);
+    for (k = 0; k < RR_WEAR_OUT; ++k) {
+        if (k == RR_WEAR_LOBES)
+            v->i[WEAR_INDEX[k]] = (int)out[k];
+        else
+            v->r[WEAR_INDEX[k]] = out[k];
+    }
+    v->r[VR_CLEARANCE_EFFECTIVE] = m->g0 - closure + out[RR_WEAR_MEAN];
+}
+
 static fmi2Status transient_step(model_runtime *m, model_values *v, double w, double me, double h, char *msg,
                                  size_t len)
 {
@@ -326,6 +370,9 @@ static fmi2Status transient_step(model_runtime *m, model_values *v, double w, do
         }
         m->st.dt = dt;
     }
+    m->surf.closure = v->r[VR_CLOSURE];
+    m->surf.offset_x = v->r[VR_OFFSET_X];
+    m->surf.offset_y = v->r[VR_OFFSET_Y];
     m->job.n_steps = ns;
     m->job.omega = w;
     m->job.me = me;
@@ -337,6 +384,7 @@ static fmi2Status transient_step(model_runtime *m, model_values *v, double w, do
         m->advanced = m->st.t - t0;
     }
     finish_outputs(v, 0.0);
+    wear_outputs(m, v);
     v->r[VR_DT_INTERNAL] = dt;
     v->i[VR_N_SUBSTEPS] = done;
     if (done < ns || m->st.diverged) {
@@ -360,6 +408,7 @@ static fmi2Status static_solution(model_runtime *m, model_values *v, double w, d
     double *J = m->K2, *A = m->Aeig, *C = m->Cm1;
     k_omega(d, w, m->Kw);
     for (i = 0; i < n; ++i) m->Fw[i] = me * w * w * d->f_unit[i];
+    m->contact.g0 = m->g0 - v->r[VR_CLOSURE]; /* the engine's closure: uniform, so a balanced solution still is */
     ok = rr_static_solve(&m->contact, w, m->Kw, m->Fw, m->have_qs ? m->qs : NULL, 1e-10, 60, q, &rel, &its, m->swork,
                          m->siwork);
     if (!ok) {
@@ -399,6 +448,7 @@ static fmi2Status static_solution(model_runtime *m, model_values *v, double w, d
     m->have_qs = 1;
     rr_outputs(&m->contact, m->qs, NULL, w, phi, OUTPUT_INDEX, v->r);
     finish_outputs(v, max_real);
+    wear_outputs(m, v);
     v->r[VR_DT_INTERNAL] = 0.0;
     v->i[VR_N_SUBSTEPS] = 0;
     /* the physical scale of a transient applies here too: a balanced solution that needs a deeper
@@ -453,22 +503,28 @@ fmi2Status model_solve_now(model_runtime *m, model_values *v, double t, char *ms
     if (g0 != m->g0) set_clearance(m, g0);
     if (m->mode != MODE_QUASI_STATIC) {
         /* the outputs of the current state (transient: they do not depend on the inputs) */
+        m->surf.phi = m->st.phi;
         rr_outputs(&m->contact, m->q, NULL, v->r[VR_OMEGA], m->st.phi, OUTPUT_INDEX, v->r);
         finish_outputs(v, 0.0);
+        wear_outputs(m, v);
         return fmi2OK;
     }
     return static_solution(m, v, v->r[VR_OMEGA], v->r[VR_IMBALANCE], m->phi_qs, msg, len);
 }
 
 /* ------------------------------------------------------------------ state snapshots */
-/* layout: tag, n, formulation, mode, g0, t, dt, phi, steps, diverged, have_qs, phi_qs, q, qp, qs */
-#define STATE_HEAD 12
+/* layout: tag, n, formulation, mode, g0, t, dt, phi, steps, diverged, have_qs, phi_qs, the liner's angle and
+ * plastic work, its cells' count, q, qp, qs, the liner's depths (np x n_sectors) */
+#define STATE_HEAD 15
 
-size_t model_state_size(const model_runtime *m) { return STATE_HEAD + 3 * (size_t)m->n; }
+static size_t liner_cells(const model_runtime *m) { return (size_t)m->np * m->surf.n_sectors; }
+
+size_t model_state_size(const model_runtime *m) { return STATE_HEAD + 3 * (size_t)m->n + liner_cells(m); }
 
 void model_state_save(const model_runtime *m, double *out)
 {
     int n = m->n, i;
+    size_t k;
     out[0] = STATE_TAG;
     out[1] = n;
     out[2] = m->formulation;
@@ -481,22 +537,29 @@ void model_state_save(const model_runtime *m, double *out)
     out[9] = m->st.diverged;
     out[10] = m->have_qs;
     out[11] = m->phi_qs;
+    out[12] = m->surf.phi;
+    out[13] = m->surf.plastic_work;
+    out[14] = (double)liner_cells(m);
     for (i = 0; i < n; ++i) {
         out[STATE_HEAD + i] = m->q[i];
         out[STATE_HEAD + n + i] = m->qp[i];
         out[STATE_HEAD + 2 * n + i] = m->qs[i];
     }
+    for (k = 0; k < liner_cells(m); ++k) out[STATE_HEAD + 3 * (size_t)n + k] = m->surf.depth[k];
 }
 
 int model_state_restore(model_runtime *m, const double *in, size_t count)
 {
     int n = m->n, i;
+    size_t k, cells = liner_cells(m);
     if (count != model_state_size(m) || in[0] != STATE_TAG || in[1] != n || in[2] != m->formulation ||
         in[3] != m->mode || !(in[6] >= 0.0) || !(in[8] >= 0.0) || (in[9] != 0.0 && in[9] != 1.0) ||
-        (in[10] != 0.0 && in[10] != 1.0))
+        (in[10] != 0.0 && in[10] != 1.0) || in[14] != (double)cells || !(in[13] >= 0.0))
         return -1;
     for (i = 4; i < (int)count; ++i)
         if (!isfinite(in[i])) return -1;
+    for (k = 0; k < cells; ++k)
+        if (!(in[STATE_HEAD + 3 * (size_t)n + k] >= 0.0)) return -1; /* a worn depth is never negative */
     set_clearance(m, in[4]);
     m->st.t = in[5];
     m->st.dt = in[6];
@@ -510,6 +573,9 @@ int model_state_restore(model_runtime *m, const double *in, size_t count)
         m->qp[i] = in[STATE_HEAD + n + i];
         m->qs[i] = in[STATE_HEAD + 2 * n + i];
     }
+    m->surf.phi = in[12];
+    m->surf.plastic_work = in[13];
+    for (k = 0; k < cells; ++k) m->surf.depth[k] = in[STATE_HEAD + 3 * (size_t)n + k];
     m->have_mats = 0; /* dt may differ */
     return 0;
 }

@@ -32,11 +32,18 @@ enum {
     VR_CHORD, VR_DT_MAX, VR_MAX_PEN, VR_SLIP
 };
 extern const int VR_N_CONTACT, VR_MAX_REAL, VR_DT_INTERNAL, VR_N_SUBSTEPS;
+/* the liner and the engine's inputs on the casing (after every earlier variable) */
+extern const int VR_LINER, VR_YIELD, VR_HARDENING, VR_THICKNESS, VR_N_SECTORS, VR_CLOSURE, VR_OFFSET_X, VR_OFFSET_Y,
+    VR_CLEARANCE_EFFECTIVE;
+/* where rr_surface_summary's RR_WEAR_OUT values go (RR_WEAR_LOBES: the Integer array) */
+extern const int WEAR_INDEX[];
+extern const double BLADE_THICKNESS; /* [m]: a tip's footprint on the liner is this x the chord */
 /* where the kernel's outputs of a state (its order, RR_N_OUT(nb)) go in the Real value array */
 extern const int OUTPUT_INDEX[];
 
 enum { STATUS_UNSTABLE = 3 }; /* quasi_static: the balanced solution is unstable */
 enum { FORMULATION_2D = 1, FORMULATION_3D = 2 };
 enum { MODE_TRANSIENT = 1, MODE_QUASI_STATIC = 2 };
+enum { LINER_RIGID = 1, LINER_ABRADABLE = 2 };
 
 #endif

@@ -33,7 +33,7 @@ from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, In
 from pythonfmu.enums import Fmi2Status
 
 MANIFEST = "rotorub_fmu.json"
-STATE_VERSION = 3
+STATE_VERSION = 4
 RE_TOL = 1e-6  # a real part below this is a neutral mode's round-off (rotorub_model.analyses.stability)
 
 # submodules of the bundled library imported eagerly: a later lazy import must not
@@ -41,6 +41,7 @@ RE_TOL = 1e-6  # a real part below this is a neutral mode's round-off (rotorub_m
 _LIB_MODULES = ("errors", "results", "kernel.compiler", "kernel", "structure.params", "structure.frames",
                 "structure.ritz", "structure.shaft", "structure.blades", "structure.casing", "structure.model",
                 "contact.geometry", "contact.point2d", "contact.chord3d", "contact.contact_model", "contact",
+                "contact.liner",
                 "analyses.linear", "analyses.transient", "analyses.static")
 
 
@@ -92,7 +93,8 @@ class RotorCasingContact(Fmi2Slave):
         self._sv = [""] * n
         self._is_real = np.array([v.type == "Real" for v in self._vars])
         self._is_int = np.array([v.type in ("Integer", "Enumeration") for v in self._vars])
-        self._real_inputs = frozenset(self._slot[k] for k in ("Omega", "imbalance", "g0"))
+        self._real_inputs = frozenset(self._slot[k] for k in ("Omega", "imbalance", "g0", "clearance_closure",
+                                                              "casing_offset.x", "casing_offset.y"))
         for i, v in enumerate(self._vars):
             self._register(i, v)
         self._set_starts()
@@ -108,6 +110,13 @@ class RotorCasingContact(Fmi2Slave):
         self._i_dt, self._i_nsub, self._i_nc = s["dt_internal"], s["n_substeps"], s["n_contact"]
         self._i_status, self._i_msg, self._i_maxre = s["status"], s["message"], s["max_real_eig"]
         self._i_gmin = s["gap_min"]
+        self._i_closure, self._i_offx, self._i_offy = s["clearance_closure"], s["casing_offset.x"], s["casing_offset.y"]
+        self._i_clear = s["clearance_effective"]
+        wear = ["wear.depth_max", "wear.depth_mean", "wear.volume", "wear.plastic_work", "wear.lobes",
+                *(f"wear.harmonic[{h}]" for h in range(1, itf.WEAR_HARMONICS + 1))]
+        self._wear_index = np.array([s[k] for k in wear], dtype=np.intp)  # rr_surface_summary's order
+        self._i_lobes = s["wear.lobes"]
+        self._wear_out = np.zeros(len(wear))
         self._get_memo: tuple[list, np.ndarray] = ([], np.zeros(0, dtype=np.intp))
         self._phase = "instantiated"  # -> initialization -> step -> terminated
         self._t = 0.0  # the FMU's time: the end of the last step taken
@@ -314,7 +323,8 @@ class RotorCasingContact(Fmi2Slave):
                 "mode": enum["Mode"][self._i("mode") - 1][0],
                 "param_file": self._sv[self._slot["param_file"]],
                 **{k: self._r(k) for k in ("k_r", "mu", "theta", "chord", "dt_max", "max_penetration",
-                                                     "slip_velocity")}}
+                                                     "slip_velocity", "yield_force", "hardening", "liner_thickness")},
+                "liner": enum["Liner"][self._i("liner") - 1][0], "n_sectors": self._i("n_sectors")}
 
     def _build(self, config: dict | None = None) -> None:
         """Build model, contact and solver from the parameters (raises with a message naming the cause)."""
@@ -350,10 +360,17 @@ class RotorCasingContact(Fmi2Slave):
         contact = lib.contact.make_contact(model, cfg["formulation"])
         sim = {"config": cfg, "model": model, "contact": contact, "g0": g0, "phi": 0.0, "q_static": None,
                "limit": (None, None), "plan": (None, None, 0), "transient": cfg["mode"] == "transient"}
+        # the casing's surface: the liner (worn or rigid) and the engine's closure and offset; its cells' area
+        # as the native FMU computes it (tip radius x cell angle x chord cos(stagger))
+        sim["liner"] = lib.liner.Liner(contact, cfg["yield_force"], cfg["hardening"], cfg["liner_thickness"],
+                                       int(cfg["n_sectors"]), wears=cfg["liner"] == "abradable",
+                                       radius=params.blades.tip_radius,
+                                       band=cfg["chord"] * math.cos(math.radians(params.blades.stagger_deg)),
+                                       tip_area=params.blades.thickness * cfg["chord"])
         if sim["transient"]:
             sim["cd"] = lib.transient.CentralDifference(model, contact, dt=None, t_ramp=0.0,
                                                         max_penetration=cfg["max_penetration"],
-                                                        omega_max_for_dt=self._r("Omega"))
+                                                        omega_max_for_dt=self._r("Omega"), liner=sim["liner"])
             sim["cd"].bind_outputs(self._out_index, self._rv)
             q = sim["cd"].q
         else:
@@ -361,6 +378,7 @@ class RotorCasingContact(Fmi2Slave):
         self._sim = sim
         self._iv[self._i_status] = self._if.STATUS_OK
         self._write_outputs(q, self._r("Omega"), 0.0, max_real=0.0)
+        self._write_wear()
         self._stale = False
         if not sim["transient"]:
             ok, msg = self._quasi_static(self._r("Omega"), self._r("imbalance"), 0.0)
@@ -460,8 +478,10 @@ class RotorCasingContact(Fmi2Slave):
             self._report(self._if.STATUS_BAD_INPUT, str(exc) if isinstance(exc, _StepRefused) else
                          f"the central-difference matrix is singular at {omega:g} rad/s, dt = {h / n:g} s")
             return False
-        done, _ = cd.advance(n, omega, me)  # the kernel writes the outputs into self._rv (bind_outputs)
         rv, iv = self._rv, self._iv
+        self._sim["liner"].set_inputs(float(rv[self._i_closure]), (float(rv[self._i_offx]), float(rv[self._i_offy])))
+        done, _ = cd.advance(n, omega, me)  # the kernel writes the outputs into self._rv (bind_outputs)
+        self._write_wear()
         iv[self._i_nc] = rv[self._i_nc]
         rv[self._i_dt] = dt
         iv[self._i_nsub] = done
@@ -473,22 +493,34 @@ class RotorCasingContact(Fmi2Slave):
         iv[self._i_status] = self._if.STATUS_OK
         return True
 
+    def _write_wear(self) -> None:
+        """The liner's summary (the kernel's) and the clearance the engine keeps, into the outputs."""
+        liner, out = self._sim["liner"], self._wear_out
+        liner.summary_into(out)
+        self._rv[self._wear_index] = out
+        self._iv[self._i_lobes] = int(out[4])
+        self._rv[self._i_clear] = self._sim["g0"] - float(self._rv[self._i_closure]) + out[1]
+
     def _quasi_static(self, omega: float, me: float, h: float) -> tuple[bool, str]:
         sim, lib = self._sim, self._lib
-        st = lib.static.solve_static(sim["model"], sim["contact"], omega, me=me, q0=sim["q_static"])
+        # the engine's closure is uniform: a balanced solution still is, at the closed clearance
+        closure = float(self._rv[self._i_closure])
+        contact = sim["contact"] if closure == 0.0 else sim["contact"].with_clearance(sim["g0"] - closure)
+        st = lib.static.solve_static(sim["model"], contact, omega, me=me, q0=sim["q_static"])
         if not st.converged:
             return False, (f"no balanced static solution at Omega = {omega:g} rad/s, imbalance = {me:g} kg.m, "
                            f"g0 = {sim['g0']:g} m (relative residual {st.residual:.2e}); the outputs hold the last "
                            "solution")
         # the kernel's eigenvalues: the native FMU computes the same indicator with the same solver
-        A = lib.linear.first_order(sim["model"], omega, *sim["contact"].jacobians(st.q, omega))
+        A = lib.linear.first_order(sim["model"], omega, *contact.jacobians(st.q, omega))
         max_real = float(lib.kernel.eigenvalues(A).real.max())
         sim["q_static"] = st.q
         phi = sim["phi"] + omega * h
         sim["phi"] = phi
         self._rv[self._i_dt] = 0.0
         self._iv[self._i_nsub] = 0
-        self._write_outputs(st.q, omega, phi, max_real=max_real)
+        self._write_outputs(st.q, omega, phi, max_real=max_real, contact=contact)
+        self._write_wear()
         # the physical scale of a transient applies here too (as in the native FMU)
         gmin, max_pen = float(self._rv[self._i_gmin]), sim["config"]["max_penetration"]
         if gmin < -max_pen:
@@ -512,10 +544,10 @@ class RotorCasingContact(Fmi2Slave):
         if not ok:
             self._report(self._if.STATUS_DIVERGED, msg)
 
-    def _write_outputs(self, q: np.ndarray, omega: float, phi: float, max_real: float) -> None:
+    def _write_outputs(self, q: np.ndarray, omega: float, phi: float, max_real: float, contact=None) -> None:
         """The outputs of state q at rest in the rotating frame (the kernel's, as in every library
         analysis) at spin omega, fixed frame at angle phi."""
-        self._sim["contact"].write_outputs(q, None, omega, phi, self._out_index, self._rv)
+        (contact or self._sim["contact"]).write_outputs(q, None, omega, phi, self._out_index, self._rv)
         self._iv[self._i_nc] = int(self._rv[self._i_nc])
         self._rv[self._i_maxre] = max_real
 
@@ -533,9 +565,9 @@ class RotorCasingContact(Fmi2Slave):
             s = {"config": dict(sim["config"]), "g0": sim["g0"], "phi": sim["phi"],
                  "q_static": None if sim["q_static"] is None else sim["q_static"].copy()}
             if "cd" in sim:
-                t, steps, phi, q, q_prev, div, dt, g0 = sim["cd"].get_state()
+                t, steps, phi, q, q_prev, div, dt, g0, ls = sim["cd"].get_state()
                 s["cd"] = {"t": t, "steps": steps, "phi": phi, "q": q, "q_prev": q_prev, "diverged": div,
-                           "dt": dt, "g0": g0}
+                           "dt": dt, "g0": g0, "liner": {"depth": ls[0], "phi": ls[1], "plastic_work": ls[2]}}
             state["sim"] = s
         return state
 
@@ -578,6 +610,13 @@ class RotorCasingContact(Fmi2Slave):
                         raise ValueError(f"integrator state '{key}' is not {n_dofs} finite values")
                 if not (float(c["dt"]) > 0 and math.isfinite(float(c["t"])) and math.isfinite(float(c["phi"]))):
                     raise ValueError("integrator time, step or angle invalid")
+                ls = c["liner"]
+                depth = np.asarray(ls["depth"], dtype=float)
+                cells = (2 if s["config"]["formulation"] == "3D" else 1, int(s["config"]["n_sectors"]))
+                if depth.shape != cells or not np.all(np.isfinite(depth)) or np.any(depth < 0):
+                    raise ValueError(f"liner depths are not {cells} finite values >= 0")
+                if not (math.isfinite(float(ls["phi"])) and float(ls["plastic_work"]) >= 0):
+                    raise ValueError("liner angle or plastic work invalid")
 
     def _restore(self, state) -> None:
         rv, iv = np.asarray(state["rv"], dtype=float), np.asarray(state["iv"], dtype=np.int64)
@@ -603,8 +642,13 @@ class RotorCasingContact(Fmi2Slave):
         sim["q_static"] = None if s["q_static"] is None else np.array(s["q_static"], dtype=float)
         if "cd" in s:
             c = s["cd"]  # set_state restores the integrator's clearance too
+            ls = c["liner"]
+            liner = sim["liner"]
             sim["cd"].set_state((c["t"], c["steps"], c["phi"], np.asarray(c["q"], dtype=float),
-                                 np.asarray(c["q_prev"], dtype=float), c["diverged"], c["dt"], c["g0"]))
+                                 np.asarray(c["q_prev"], dtype=float), c["diverged"], c["dt"], c["g0"],
+                                 (np.asarray(ls["depth"], dtype=float), float(ls["phi"]), float(ls["plastic_work"]),
+                                  liner.closure, liner.offset)))
+            self._write_wear()
         if s["g0"] != sim["g0"]:
             sim["g0"] = s["g0"]
             self._apply_clearance(s["g0"])

@@ -31,7 +31,13 @@ from ..structure.model import Model
 def contact_potential(contact: ContactModel, Q: np.ndarray) -> np.ndarray:
     """Penalty energy of the normal contact pressure of states Q (m, n) [J]: its gradient is
     -F_nl without friction (Simpson's rule is exact for the quadratic integrand)."""
-    g = contact.gaps_batch(np.atleast_2d(Q))  # (m, N, P)
+    return contact_potential_of_gaps(contact, contact.gaps_batch(np.atleast_2d(Q)))
+
+
+def contact_potential_of_gaps(contact: ContactModel, g: np.ndarray) -> np.ndarray:
+    """The same from the states' gaps (m, N, P): what a run against a worn liner records (its outputs' gaps
+    are to the worn surface, which the model's own gaps(q) do not know)."""
+    g = np.asarray(g, dtype=float)
     if contact.n_points == 1:
         return 0.5 * contact.k_r * np.sum(np.minimum(g[..., 0], 0.0) ** 2, axis=1)
     l = contact.geometry.chord

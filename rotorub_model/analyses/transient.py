@@ -41,6 +41,7 @@ import numpy as np
 
 from .. import kernel
 from ..contact import ContactModel
+from ..contact.liner import Liner
 from ..errors import ParameterError
 from ..results import pyplot, save_figure, save_result
 from ..structure.model import Model
@@ -73,7 +74,8 @@ class CentralDifference:
     """
 
     def __init__(self, model: Model, contact: ContactModel, dt: float | None = None, t_ramp: float = 1.0,
-                 max_penetration: float | None = None, omega_max_for_dt: float | None = None):
+                 max_penetration: float | None = None, omega_max_for_dt: float | None = None,
+                 liner: Liner | None = None):
         if t_ramp is None or not math.isfinite(t_ramp) or t_ramp < 0:
             raise ParameterError(f"t_ramp: {t_ramp} out of range; accepted range [0, inf) s")
         if max_penetration is None:  # the parameter file's (contact.max_penetration: an abradable liner's depth)
@@ -96,6 +98,7 @@ class CentralDifference:
         self._addresses: dict[int, tuple[np.ndarray, int]] = {}
         self._key = None
         self._mats = None
+        self.liner = liner
         self.contact = contact
 
     # the scheme's scalars live in the kernel's state struct
@@ -115,7 +118,12 @@ class CentralDifference:
     def contact(self, c: ContactModel) -> None:
         self._contact = c
         self._run = c.lib.rr_cd_run
-        self._job.contact = ctypes.addressof(c.kernel)
+        if self.liner is None:
+            self._job.contact = ctypes.addressof(c.kernel)
+        else:  # the loop's own view of the contact, with the liner's surface (the model's own stays rigid)
+            self.liner.contact = c
+            self._seen = self.liner.attach(c.kernel)
+            self._job.contact = ctypes.addressof(self._seen)
 
     @staticmethod
     def _check_dt(dt: float | None, limit: float) -> float:
@@ -177,6 +185,18 @@ class CentralDifference:
         self._job.out_index = None if dest is None else kernel.iptr(index)
         self._job.out_dest = None if dest is None else kernel.ptr(dest)
 
+    def record_wear(self, every: int, rows: np.ndarray | None) -> None:
+        """With a liner: its profile every ``every``-th step of the run into ``rows`` (n, n_sectors), from
+        its first row on (None: stop recording); :attr:`wear_records` counts the rows written."""
+        self._wear_rows = rows  # kept alive while the kernel writes into it
+        job = self._job
+        job.rec_wear_every = int(every)
+        job.rec_wear_cap = 0 if rows is None else rows.shape[0]
+        job.n_rec_wear = 0
+        job.rec_wear = None if rows is None else kernel.ptr(rows)
+
+    wear_records = property(lambda self: self._job.n_rec_wear)
+
     def advance(self, n_steps: int, omega: float, me: float, omega_dot: float = 0.0,
                 rec_every: int = 0, rec_q: np.ndarray | None = None, rec_start: int = 0,
                 rec_out: np.ndarray | None = None) -> tuple[int, int]:
@@ -220,15 +240,17 @@ class CentralDifference:
     # state for rollback (FMU get/set state)
     def get_state(self) -> tuple:
         return (self.t, self.steps, self.phi, self.q.copy(), self.q_prev.copy(), self.diverged, self.dt,
-                self.contact.g0)
+                self.contact.g0, None if self.liner is None else self.liner.get_state())
 
     def set_state(self, state: tuple) -> None:
-        t, steps, phi, q, q_prev, div, dt, g0 = state
+        t, steps, phi, q, q_prev, div, dt, g0, *rest = state
         self.t, self.steps, self.phi, self.diverged, self.dt = float(t), int(steps), float(phi), bool(div), float(dt)
         self.q[:] = q
         self.q_prev[:] = q_prev
         if g0 != self.contact.g0:
             self.set_clearance(g0)
+        if self.liner is not None and rest and rest[0] is not None:
+            self.liner.set_state(rest[0])
         self._key = None
 
     def velocity(self) -> np.ndarray:
@@ -294,6 +316,7 @@ class TransientResult:
     t_end: float  # time reached
     message: str
     omega_ref: float
+    wear: dict | None = None  # with a liner: t, angles, profiles (nt, n_sectors), depth (rows), summary
 
     def blades_in_contact(self, i: int = -1) -> int:
         return int(np.sum(self.outputs["F_N"][i] > 0))
@@ -353,6 +376,8 @@ def run_transient(
     max_penetration: float | None = None,
     progress: bool = False,
     hold: float | None = None,
+    liner: Liner | None = None,
+    wear_record_dt: float = 0.05,
 ) -> TransientResult:
     """Central-difference transient from rest (or q0, v0), imbalance ramped over t_ramp.
 
@@ -364,6 +389,10 @@ def run_transient(
     length ``hold`` and held over it (zero-order hold, Euler terms off), and the step
     is the largest that divides ``hold`` within the stability cap. ``record_dt`` must
     then be a whole multiple of ``hold``.
+
+    ``liner`` (contact/liner.py): the casing's abradable liner, cut as the run goes (its state is the
+    liner's: a second run goes on from the profile the first left); its profile is recorded every
+    ``wear_record_dt`` seconds into ``result.wear``.
     """
     for name, v, lo in (("t_end", t_end, 0.0), ("record_dt", record_dt, 0.0), ("segment", segment, 0.0)):
         if not math.isfinite(v) or v <= lo:
@@ -382,8 +411,10 @@ def run_transient(
     speeds = np.array([omega_fn(t) for t in ts])
     if not np.all(np.isfinite(speeds)) or np.any(speeds < 0):
         raise ParameterError("omega: spin speed must be finite and >= 0 rad/s over the whole run")
+    if liner is not None and not (math.isfinite(wear_record_dt) and wear_record_dt > 0):
+        raise ParameterError(f"wear_record_dt: {wear_record_dt} out of range; accepted range (0, inf) s")
     integ = CentralDifference(model, contact, dt, 0.0 if hold else t_ramp, max_penetration,
-                              omega_max_for_dt=float(speeds.max()))
+                              omega_max_for_dt=float(speeds.max()), liner=liner)
     if hold is not None:
         # same rule as the FMU: n = ceil(h / cap) substeps per held interval
         integ.dt = hold / max(1, math.ceil(hold / integ.dt * (1 - 1e-9)))
@@ -391,6 +422,10 @@ def run_transient(
         # automatic step: shrink it so the records fall exactly on multiples of record_dt
         integ.dt = record_dt / math.ceil(record_dt / integ.dt)
     dt_ = integ.dt
+    for name, a in (("q0", q0), ("v0", v0)):
+        if a is not None and (np.shape(a) != (model.n_dofs,) or not np.all(np.isfinite(a))):
+            raise ParameterError(f"{name}: expected {model.n_dofs} finite values (the model's dofs), got shape "
+                                 f"{np.shape(a)}{'' if np.all(np.isfinite(a)) else ' with non-finite values'}")
     if q0 is not None:
         integ.q[:] = q0
         integ.q_prev[:] = q0 - (dt_ * v0 if v0 is not None else 0.0)
@@ -403,6 +438,10 @@ def run_transient(
     seg_steps = n_total if constant else max(1, int(round(segment / dt_)))
     if hold is not None:
         seg_steps = max(1, int(round(hold / dt_)))
+    if liner is not None:  # the kernel copies the profile every wear_every steps as it goes
+        wear_every = max(1, int(round(wear_record_dt / dt_)))
+        wear_rows = np.zeros((n_total // wear_every, liner.n_sectors))
+        integ.record_wear(wear_every, wear_rows)
     phi_rec = []
     done_total, written = 0, 0
     bar = None
@@ -450,5 +489,11 @@ def run_transient(
         if integ.diverged
         else f"completed {t_end:g} s in {done_total} steps of {dt_:.3e} s"
     )
+    wear = None
+    if liner is not None:
+        k = integ.wear_records
+        integ.record_wear(0, None)
+        wear = {"t": (np.arange(k) + 1) * wear_every * dt_, "angles": liner.angles, "profiles": wear_rows[:k].copy(),
+                "depth": liner.depth.copy(), "summary": liner.summary()}
     return TransientResult(contact.formulation, t_rec, q_rec, om, outs, dt_, integ.dt_limit, integ.diverged,
-                           integ.t, msg, model.params.normalisation.omega_ref)
+                           integ.t, msg, model.params.normalisation.omega_ref, wear)

@@ -73,6 +73,13 @@ def check_arguments(ns: argparse.Namespace, p) -> None:
     if v is not None and not (math.isfinite(v) and -p.contact.max_penetration <= v <= 0.1):
         bad("g0", v, f"[{-p.contact.max_penetration:g}, 0.1] m (down to an interference as deep as "
             "contact.max_penetration)")
+    for name in ("closure", "offset_x", "offset_y"):
+        v = getattr(ns, name, None)
+        if v is not None and not (math.isfinite(v) and abs(v) <= 0.01):
+            bad(name.replace("_", "-"), v, "[-0.01, 0.01] m (an engine's closure or casing offset)")
+    v = getattr(ns, "yield_force", None)
+    if v is not None and not (math.isfinite(v) and v > 0):
+        bad("yield-force", v, "(0, inf) N")
     v = getattr(ns, "formulation", None)
     if v is not None and v not in ("2D", "3D"):
         bad("formulation", v, "2D or 3D")
@@ -206,6 +213,26 @@ def cmd_transient(ns: argparse.Namespace) -> dict:
     from .studies import run_transient_study
 
     return run_transient_study(_model(ns), ns.out, ns.speed, ns.g0, t_end=ns.t_end, stab_dir=ns.maps)
+
+
+@command("wear", "2D and 3D transients against an abradable liner: wear map, worn profile, volume, plastic work, "
+         "lobes, the clearance left")
+@arg("--speed", type=float, default=None, help="normalised spin speed (default: the transient study's point)")
+@arg("--g0", type=float, default=None, help="nominal clearance [m] (default: picked with the speed)")
+@arg("--t-end", type=float, default=20.0, help="simulated time [s] (imbalance ramped over the first second)")
+@arg("--closure", type=float, default=0.0, help="uniform clearance closure from the engine [m] (> 0 closes)")
+@arg("--offset-x", type=float, default=0.0, help="casing centre offset, fixed frame, x [m]")
+@arg("--offset-y", type=float, default=0.0, help="casing centre offset, fixed frame, y [m]")
+@arg("--yield-force", type=float, default=None, help="liner yield force [N] (default: abradable.yield_force)")
+@arg("--maps", default=None, help="a stability study's folder to pick the point from")
+def cmd_wear(ns: argparse.Namespace) -> dict:
+    from .studies import run_wear_study
+
+    liner = {} if ns.yield_force is None else {"yield_force": ns.yield_force}
+    s = run_wear_study(_model(ns), ns.out, ns.speed, ns.g0, t_end=ns.t_end, closure=ns.closure,
+                       offset=(ns.offset_x, ns.offset_y), stab_dir=ns.maps, **liner)
+    return {f: {k: s[f][k] for k in ("depth_max_mm", "removed_volume_mm3", "plastic_work_J", "lobes",
+                                     "clearance_effective_mm")} for f in ("2D", "3D")}
 
 
 @command("detect", "contact detection maps over (speed, g0): 2D, 3D, degraded 3D, theta and chord sweeps")

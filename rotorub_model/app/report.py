@@ -15,6 +15,9 @@ FIGURES = [
     ("Detection vs chord length (paper Fig. 9)", "detection/detection_chord.png"),
     ("Static solutions and their stability, 2D and 3D (paper Fig. 10-11)", "stability/stability_maps.png"),
     ("Normal contact forces per blade, 2D vs 3D transient (paper Fig. 12)", "transient/contact_forces.png"),
+    ("Wear map: the same rub against an abradable liner, 3D (depth over angle and time)", "wear/3D/wear_map.png"),
+    ("Worn profile after the rub, 3D: unrolled, polar, spectrum", "wear/3D/wear_profile.png"),
+    ("Worn profile after the rub, 2D", "wear/2D/wear_profile.png"),
     ("Continuation: static branches, special points and periodic orbits at the section-6 speed",
      "continuation/continuation.png"),
     ("Stability boundary by continuation over the grid maps", "continuation/boundaries.png"),
@@ -225,6 +228,41 @@ def _fmu_section(summary: dict) -> list[str]:
         lines += ["", "## Coupled engine scenario (LP spool FMU + contact FMU)", "",
                   "| quantity | value |", "|---|---|"]
         lines += [f"| {_label(k)} | {_fmt(v)} |" for k, v in c.items() if not isinstance(v, dict | list)]
+    w = summary.get("coupled_wear_run")
+    if w:
+        lines += ["", "## Engine scenario with wear (spool + clearance closure + contact with its liner)", "",
+                  f"A run-up through the first critical speed with a quarter of the reference imbalance "
+                  f"({w['imbalance_kg_m'] * 1e3:g} kg·mm) and g0 = {w['g0_mm']:g} mm: held at g0 the blades never "
+                  f"touch (wear {w['no_closure_wear_depth_max_mm']:g} mm); the engine's closure (up to "
+                  f"{w['closure_max_mm']:.3g} mm) makes them rub from t = {_fmt(w['t_first_contact_s'])} s and cut "
+                  f"the liner {w['wear_depth_max_mm'] * 1e3:.1f} µm deep ({w['wear_volume_mm3']:.4g} mm³). At the "
+                  f"end the engine keeps {w['clearance_effective_end_mm']:.4g} mm where an unworn liner would leave "
+                  f"{w['clearance_without_wear_end_mm']:.4g} mm: {w['clearance_penalty_mm'] * 1e3:.1f} µm more, "
+                  f"about {w['fuel_burn_penalty_estimate_pct']:.2g} % fuel burn by the rule of thumb "
+                  f"({w['fuel_burn_rule']}). The package runs the same in fmpy, in libcosim (largest relative "
+                  f"difference {_fmt(_largest(w.get('libcosim_max_rel_diff')))}) and in the C master "
+                  f"({_fmt(_largest(w.get('native_host_max_rel_diff')))})."]
+    return lines
+
+
+def _largest(d: dict | None) -> float | None:
+    return None if not d else max(d.values())
+
+
+def _wear_section(w: dict) -> list[str]:
+    lines = ["", "## The section-6 rub against an abradable liner", "",
+             f"Not in the paper (its casing is rigid): the same transient at Ω = {w['speed']:.4g}, g0 = "
+             f"{w['g0_mm']:.4g} mm against the parameter file's liner, worn (docs/THEORY.md, \"Abradable liner\").",
+             "", "| formulation | deepest wear | mean wear | volume removed | plastic work | lobes | clearance "
+             "before → after |", "|---|---|---|---|---|---|---|"]
+    for f in ("2D", "3D"):
+        s = w.get(f)
+        if not s:
+            continue
+        lobes = s["lobes"] if s["lobes"] else "none (worn evenly: a 360° rub)"
+        lines.append(f"| {f} | {s['depth_max_mm'] * 1e3:.1f} µm | {s['depth_mean_mm'] * 1e3:.1f} µm | "
+                     f"{s['removed_volume_mm3']:.4g} mm³ | {s['plastic_work_J']:.4g} J | {lobes} | "
+                     f"{s['clearance_before_mm']:.4g} → {s['clearance_effective_mm']:.4g} mm |")
     return lines
 
 
@@ -291,6 +329,8 @@ def write_report(out: str | Path, summary: dict) -> Path:
         lines.append("Every fact holds on this configuration.")
     for f in failing:
         lines.append(f"* Fact {f['id']}: {f.get('why', 'see the values in the table and docs/THEORY.md')}")
+    if "wear" in summary:
+        lines += _wear_section(summary["wear"])
     if "continuation" in summary:
         lines += _continuation_section(summary["continuation"])
     if "blade_discretisation" in summary:

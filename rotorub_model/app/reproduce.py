@@ -155,7 +155,7 @@ def run_reproduce(model: Model, out: str | Path, quick: bool = False, params_fil
     from ..analyses.linear import run_campbell, run_modes, run_response
 
     out = Path(out)
-    sizes = {"response": 600 if quick else 2000, "campbell": 25 if quick else 80,
+    sizes = {"response": 600 if quick else 2000, "campbell": 400,
              "discretisation": 13 if quick else 41, "transient_t_end_s": 20.0}
     resp = run_response(model, n_speeds=sizes["response"]).save(out / "response")
     run_modes(model, resp["critical_speeds"][0]).save(out / "modes")
@@ -172,6 +172,10 @@ def run_reproduce(model: Model, out: str | Path, quick: bool = False, params_fil
     disc_summary["table_markdown"] = disc.table_markdown()
     stab = run_stability_study(model, out / "stability", quick=quick)
     tr = run_transient_study(model, out / "transient", stab_dir=out / "stability", t_end=sizes["transient_t_end_s"])
+    from .studies import run_wear_study
+
+    # the same rub against an abradable liner (the parameter file's, worn): what it leaves behind
+    wear = run_wear_study(model, out / "wear", tr["speed"], tr["g0_mm"] * 1e-3, t_end=sizes["transient_t_end_s"])
     from .studies import run_continuation_study
 
     cont = run_continuation_study(model, out / "continuation", maps_dir=out / "stability", quick=quick)
@@ -183,6 +187,7 @@ def run_reproduce(model: Model, out: str | Path, quick: bool = False, params_fil
         "detection": det,
         "stability": {k: v for k, v in stab.items() if not k.startswith("map_")},
         "transient": tr,
+        "wear": wear,
         "blade_discretisation": disc_summary,
         "continuation": cont,
         "paper_facts": [fact1(resp), *detection_facts(det), fact5(stab), *fact6(tr)],

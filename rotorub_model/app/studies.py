@@ -386,6 +386,26 @@ def run_transient_study(model: Model, out: str | Path, speed: float | None = Non
     return TransientStudy(speed, g0, runs, statics).save(out)
 
 
+def run_wear_study(model: Model, out: str | Path, speed: float | None = None, g0: float | None = None,
+                   t_end: float = 20.0, closure: float = 0.0, offset: tuple[float, float] = (0.0, 0.0),
+                   stab_dir: str | Path | None = None, progress: bool = True, **liner) -> dict:
+    """2D and 3D transients against the parameter file's abradable liner (``analyses.wear``), at the transient
+    study's point unless given; writes out/{2D,3D}/ (wear map, profile, forces, JSON, NPZ) and summary.json."""
+    from ..analyses.wear import run_wear
+
+    if (speed is None) != (g0 is None):
+        raise ParameterError("wear point: give both --speed and --g0, or neither (the transient study's point)")
+    if speed is None:
+        speed, g0 = pick_transient_point(model, stab_dir, progress=progress, t_end=t_end)
+    out = Path(out)
+    summary = {"speed": speed, "g0_mm": g0 * 1e3}
+    for f in ("2D", "3D"):
+        summary[f] = run_wear(model, f, speed, g0, t_end=t_end, closure=closure, offset=offset, progress=progress,
+                              **liner).save(out / f)
+    write_json(out / "summary.json", summary)
+    return summary
+
+
 def run_continuation_study(model: Model, out: str | Path, speed: float | None = None,
                            maps_dir: str | Path | None = None, quick: bool = True, progress: bool = True) -> dict:
     """Branches, special points, orbits and boundary curves (``analyses.continuation``) against the

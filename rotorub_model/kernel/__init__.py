@@ -31,7 +31,7 @@ SOURCES = (HERE / "rotorub_kernel.c",)
 HEADER = HERE / "rotorub_kernel.h"
 MATH_HEADER = HERE / "rr_math.h"  # the elementary functions: the same bits on every platform
 HEADERS = (HEADER, MATH_HEADER)
-ABI_VERSION = 5
+ABI_VERSION = 6
 LAW_WIDTH = 7
 OUT_BLADE_BLOCKS = 6
 OUT_GLOBALS = 8
@@ -50,7 +50,21 @@ class RRContact(ctypes.Structure):
     _fields_ = [("n", ctypes.c_int), ("nb", ctypes.c_int), ("np", ctypes.c_int), ("g0", ctypes.c_double),
                 ("k_r", ctypes.c_double), ("mu", ctypes.c_double), ("chord", ctypes.c_double),
                 ("v_slip", ctypes.c_double), ("G", _dp), ("A", _dp), ("B", _dp), ("S", _dp), ("points", _dp),
-                ("normals", _dp), ("tangents", _dp), ("T2", _dp), ("work", _dp)]
+                ("normals", _dp), ("tangents", _dp), ("T2", _dp), ("work", _dp), ("surface", ctypes.c_void_p)]
+
+
+class RRSurface(ctypes.Structure):
+    _fields_ = [("n_sectors", ctypes.c_int), ("wears", ctypes.c_int), ("yield_force", ctypes.c_double),
+                ("hardening", ctypes.c_double), ("thickness", ctypes.c_double), ("closure", ctypes.c_double),
+                ("offset_x", ctypes.c_double), ("offset_y", ctypes.c_double), ("phi", ctypes.c_double),
+                ("work_weight", ctypes.c_double), ("plastic_work", ctypes.c_double), ("changed", ctypes.c_int),
+                ("tables", _dp), ("depth", _dp)]
+
+
+WEAR_HARMONICS = 8
+# rr_surface_summary's layout (rotorub_kernel.h)
+WEAR_NAMES = ("depth_max", "depth_mean", "volume", "plastic_work", "lobes",
+              *(f"harmonic_{h}" for h in range(1, WEAR_HARMONICS + 1)))
 
 
 class RRGeometrySpec(ctypes.Structure):
@@ -80,7 +94,8 @@ class RRJob(ctypes.Structure):
                 ("n_steps", ctypes.c_int), ("omega", ctypes.c_double), ("me", ctypes.c_double),
                 ("t_ramp", ctypes.c_double), ("rec_every", ctypes.c_int), ("rec_cap", ctypes.c_int),
                 ("n_rec", ctypes.c_int), ("rec_q", _dp), ("rec_out", _dp), ("out_index", _ip), ("out_dest", _dp),
-                ("done", ctypes.c_int)]
+                ("done", ctypes.c_int), ("rec_wear_every", ctypes.c_int), ("rec_wear_cap", ctypes.c_int),
+                ("n_rec_wear", ctypes.c_int), ("rec_wear", _dp)]
 
 
 def source_id() -> str:
@@ -154,6 +169,15 @@ def _declare(lib: ctypes.CDLL) -> ctypes.CDLL:
     lib.rr_elementary.restype = None
     lib.rr_cd_run.argtypes = [ctypes.c_void_p]
     lib.rr_cd_run.restype = ctypes.c_int
+    lib.rr_surface_table_size.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_int]
+    lib.rr_surface_table_size.restype = ctypes.c_int
+    lib.rr_surface_init.argtypes = [c, ctypes.c_void_p]
+    lib.rr_surface_init.restype = ctypes.c_int
+    lib.rr_liner_law.argtypes = [ctypes.c_double] * 5 + [ctypes.c_int, ctypes.POINTER(ctypes.c_double),
+                                                         ctypes.POINTER(ctypes.c_double)]
+    lib.rr_liner_law.restype = ctypes.c_double
+    lib.rr_surface_summary.argtypes = [c, ctypes.c_void_p, ctypes.c_double, _dp]
+    lib.rr_surface_summary.restype = None
     for name in ("rr_blade_law", "rr_laws", "rr_friction", "rr_force", "rr_jacobian", "rr_gaps_batch", "rr_outputs",
                  "rr_outputs_batch"):
         getattr(lib, name).restype = None
@@ -217,6 +241,15 @@ def point_law(g: float, k: float) -> tuple[float, float]:
     out = (ctypes.c_double * LAW_WIDTH)()
     load().rr_blade_law(1, float(g), 0.0, float(k), 1.0, out)
     return out[0], out[2]
+
+
+def liner_law(g: float, k: float, fy: float, h: float, thickness: float, depth: float = 0.0,
+              wears: bool = True) -> tuple[float, float, float]:
+    """The kernel's abradable-liner law at one cell: (force, depth after the cut, work dissipated)."""
+    d, w = ctypes.c_double(float(depth)), ctypes.c_double(0.0)
+    f = load().rr_liner_law(float(g), float(k), float(fy), float(h), float(thickness), int(bool(wears)),
+                            ctypes.byref(d), ctypes.byref(w))
+    return f, d.value, w.value
 
 
 def eigenvalues(A: np.ndarray) -> np.ndarray:

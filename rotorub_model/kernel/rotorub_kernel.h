@@ -50,7 +50,7 @@ extern "C" {
 #endif
 
 /* Bumped whenever a struct layout or a signature below changes. */
-#define RR_ABI_VERSION 5
+#define RR_ABI_VERSION 6
 
 /* Per-blade law values (rr_laws): F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction. */
 #define RR_LAW_WIDTH 7
@@ -81,6 +81,39 @@ RR_API void rr_elementary(int fn, int m, const double *x, const double *y, doubl
 /* number of outputs of a state for nb blades */
 #define RR_N_OUT(nb) (RR_OUT_BLADE_BLOCKS * (nb) + RR_OUT_GLOBALS)
 
+/* The casing's inner surface as the engine and a rub leave it (docs/THEORY.md, "Abradable liner"): an
+ * abradable liner in n_sectors cells over the circumference (fixed frame), one row per contact point of a
+ * blade (2D: the tip; 3D: LE and TE, the worn surface linear between them along the chord), each cell with
+ * a worn depth; and two inputs from the engine, a uniform closure of the clearance and a rigid offset of
+ * the casing's centre. A contact point's gap is its gap to the unworn, centred casing plus
+ *     depth(row, sector of the point) - closure + n_r (offset_x cos th + offset_y sin th),
+ * th the point's fixed-frame angle, n_r the radial part of the casing normal there. The liner's law, at
+ * each cell a contact point sweeps in a step: elastic (the contact's penalty k_r) up to the yield force
+ * F_y + H depth, material removed beyond it (depth grows so that the force returns to that bound; H the
+ * linear hardening), never deeper than the liner's thickness; in 3D each end point carries half the chord
+ * (k_r / 2, F_y / 2, H / 2: a chord pressed uniformly yields at the same total force as a 2D tip). The
+ * surface is read by every function below that evaluates gaps, at the frame angle phi; only the time loop
+ * (rr_cd_run) cuts it. Arrays are owned by the caller; rr_surface_init fills the tables. */
+#define RR_WEAR_HARMONICS 8 /* profile harmonics in the summary */
+typedef struct {
+    int n_sectors;       /* cells over 2 pi (>= 8) */
+    int wears;           /* 1: cut by the law; 0: a fixed surface (the liner as it is, closure, offset) */
+    double yield_force;  /* F_y [N] per blade tip (> 0) */
+    double hardening;    /* H [N/m] (>= 0) */
+    double thickness;    /* liner thickness [m]: no wear beyond (> 0) */
+    double closure;      /* uniform closure of the clearance [m] (engine input; > 0 closes) */
+    double offset_x;     /* rigid offset of the casing centre, fixed frame [m] (engine input) */
+    double offset_y;
+    double phi;          /* frame angle of the state the gaps are evaluated at; the time loop keeps it [rad] */
+    double work_weight;  /* a cell's area over a blade tip's (the law is a tip's): the plastic work per cell is
+                          * the law's times this, so that it is the yield pressure times the volume, whatever
+                          * the cells' count (> 0) */
+    double plastic_work; /* work dissipated in removing the liner since the start [J] (state) */
+    int changed;         /* set when a cell is cut (a summary clears nothing: for the caller) */
+    double *tables;      /* rr_surface_table_size(nb, np, n_sectors) doubles, filled by rr_surface_init */
+    double *depth;       /* (np, n_sectors) worn depth [m] (state) */
+} rr_surface;
+
 /* Contact geometry and law parameters of one formulation (all arrays owned by the caller). */
 typedef struct {
     int n;            /* generalised coordinates */
@@ -100,6 +133,7 @@ typedef struct {
     const double *tangents; /* (nb*np, 3) sliding directions e_t */
     const double *T2;    /* (2, n) fan-disk translation (rotating frame) */
     double *work;        /* scratch of at least rr_work_size(n, nb, np) doubles */
+    rr_surface *surface; /* the casing's worn, closed and offset surface, or NULL (the paper's rigid casing) */
 } rr_contact;
 
 /* What the contact geometry is built from: the structure's maps at the fan disk and at the
@@ -211,12 +245,37 @@ typedef struct {
     const int *out_index; /* outputs of the final state (fixed frame) go to out_dest[out_index[k]] */
     double *out_dest;     /* (NULL: not written) */
     int done;             /* out: steps done (fewer than n_steps if the run diverged) */
+    /* the liner's profile (rows' mean per cell) every rec_wear_every-th step of the run (counted by
+     * state->steps), into rec_wear (rec_wear_cap rows of n_sectors) from row n_rec_wear (in/out) */
+    int rec_wear_every, rec_wear_cap, n_rec_wear;
+    double *rec_wear;
 } rr_cd_job;
 
 /* Advance job->n_steps central-difference steps at constant matrices, external force
  * f * me * r(t) + f0; the friction of each step uses the velocity (q - q_prev) / dt. Returns the steps done; fewer than n_steps if a gap fell below -max_pen or a
  * value stopped being finite (state->diverged is then set and further calls do nothing). */
 RR_API int rr_cd_run(rr_cd_job *job);
+
+/* ------------------------------------------------------------------ abradable liner */
+/* Doubles of rr_surface.tables for nb blades of np points and n_sectors cells. */
+RR_API int rr_surface_table_size(int nb, int np, int n_sectors);
+/* Check the surface's parameters against the contact (np rows) and fill its tables (the points' angles
+ * and normals, the profile's Fourier basis). Returns 0, or -1 if a parameter is out of range. */
+RR_API int rr_surface_init(const rr_contact *c, rr_surface *s);
+/* The liner's law at one cell: a point of raw gap g (its gap to the unworn surface, closure and offset
+ * included) over a cell worn to *depth; stiffness k, yield force fy, hardening h, thickness, all of the
+ * point's share. Cuts *depth (if wears) and adds the dissipated work to *work; returns the point's normal
+ * force k (-(g + depth))_+ after the cut. */
+RR_API double rr_liner_law(double g, double k, double fy, double h, double thickness, int wears, double *depth,
+                           double *work);
+/* Summary of the worn profile (the rows' mean at every cell) into out[RR_WEAR_OUT]: largest and mean
+ * depth [m], removed volume [m^3] (area_per_sector: a cell's area on the casing, m^2), the plastic work
+ * [J], the dominant lobe count (the harmonic 1..RR_WEAR_HARMONICS of largest amplitude; 0 for a profile
+ * without wear, or worn evenly: no harmonic reaches 1 % of the mean depth) and the amplitudes of harmonics
+ * 1..RR_WEAR_HARMONICS [m]. */
+enum { RR_WEAR_MAX = 0, RR_WEAR_MEAN, RR_WEAR_VOLUME, RR_WEAR_WORK, RR_WEAR_LOBES, RR_WEAR_AMP,
+       RR_WEAR_OUT = RR_WEAR_AMP + RR_WEAR_HARMONICS };
+RR_API void rr_surface_summary(const rr_contact *c, const rr_surface *s, double area_per_sector, double *out);
 
 /* ------------------------------------------------------------------ dense linear algebra */
 /* LU with partial pivoting, in place (n x n row-major); returns 0, or -1 if a pivot is zero. */

@@ -163,6 +163,26 @@ class ContactParams:
 
 
 @dataclass(frozen=True)
+class AbradableParams:
+    """The casing's abradable liner (docs/THEORY.md, "Abradable liner"); off by default: the paper's casing
+    is rigid, and every result of the reference stays as it is."""
+
+    enabled: bool = field(default=False, metadata={"doc": "the casing is lined with a coating that wears (the "
+                                                          "paper: false, a rigid casing)", "bool": True})
+    yield_force: float = _f(0, lo_open=True, default=100.0,
+                            doc="a blade tip's normal force at which the liner starts to be removed [N] (a 3D "
+                                "chord pressed uniformly yields at the same total force); default: of the order "
+                                "of the reference rub's own forces, so that it wears (docs/THEORY.md 4.1); a "
+                                "coating's crushing strength times the tip's footprint for a given liner")
+    hardening: float = _f(0, default=0.0, doc="linear hardening: yield force gained per metre removed [N/m] "
+                                               "(0: perfectly plastic)")
+    thickness: float = _f(0, 0.05, lo_open=True, default=2.0e-3,
+                          doc="liner thickness [m]: no wear beyond it (the casing's substrate)")
+    n_sectors: int = _f(8, 100000, integer=True, default=720,
+                        doc="cells of the liner over the circumference (fixed frame; 720: half a degree)")
+
+
+@dataclass(frozen=True)
 class NormalisationParams:
     omega_ref: float = _f(0, lo_open=True, doc="reference angular speed for the normalised spin speed [rad/s]")
     speed_max: float = _f(0, lo_open=True, default=12.0,
@@ -183,6 +203,7 @@ class Parameters:
     imbalance: ImbalanceParams
     contact: ContactParams
     normalisation: NormalisationParams
+    abradable: AbradableParams = AbradableParams()
 
     def replace(self, **sections: dict[str, Any]) -> Parameters:
         """Return a copy with some fields of some sections replaced, validated again.
@@ -214,7 +235,9 @@ _SECTIONS: dict[str, type] = {
     "imbalance": ImbalanceParams,
     "contact": ContactParams,
     "normalisation": NormalisationParams,
+    "abradable": AbradableParams,
 }
+_OPTIONAL_SECTIONS = {"abradable"}  # may be left out of a parameter file: every field has its default
 _LISTS: dict[str, type] = {"bearings": BearingParams, "disks": DiskParams}
 
 
@@ -235,6 +258,10 @@ def _check_value(where: str, f: dataclasses.Field, value: Any) -> Any:
         if len(set(value)) != len(value):
             raise ParameterError(f"{where}: repeated nodal diameter in {list(value)}")
         return tuple(int(n) for n in value)
+    if meta.get("bool"):
+        if not isinstance(value, bool):
+            raise ParameterError(f"{where}: expected true or false, got {value!r}")
+        return value
     if f.type in ("str", str):
         if not isinstance(value, str) or not value:
             raise ParameterError(f"{where}: expected a non-empty string, got {value!r}")
@@ -284,6 +311,9 @@ def from_dict(data: dict[str, Any]) -> Parameters:
         raise ParameterError(f"{unknown[0]}: unknown section; accepted: {', '.join(sorted(known))}")
     kwargs: dict[str, Any] = {}
     for sec, cls in _SECTIONS.items():
+        if sec not in data and sec in _OPTIONAL_SECTIONS:
+            kwargs[sec] = cls()
+            continue
         if sec not in data:
             raise ParameterError(f"{sec}: missing section")
         kwargs[sec] = _build(cls, sec, data[sec])
@@ -381,6 +411,33 @@ def reference_parameters() -> Parameters:
     if _REFERENCE is None:
         _REFERENCE = load_parameters(None)
     return _REFERENCE
+
+
+def _toml_value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        return repr(v)  # the shortest decimal that reads back to the same double; valid TOML
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, list | tuple):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    raise TypeError(f"no TOML form for {v!r}")
+
+
+def to_toml(p: Parameters) -> str:
+    """The parameters as a TOML parameter file (what :func:`load_parameters` reads back to the same values)."""
+    d = to_dict(p)
+    lines = ["# rotorub parameter file (SI units), written by rotorub_model.structure.params.to_toml", ""]
+    for sec, val in d.items():
+        if isinstance(val, list):
+            for item in val:
+                lines += [f"[[{sec}]]", *(f"{k} = {_toml_value(v)}" for k, v in item.items()), ""]
+        else:
+            lines += [f"[{sec}]", *(f"{k} = {_toml_value(v)}" for k, v in val.items()), ""]
+    return "\n".join(lines)
 
 
 def to_dict(p: Parameters) -> dict[str, Any]:

@@ -1,0 +1,118 @@
+/*
+ * clearance_model.c: TipClearance in C behind the shared FMI wrapper (fmu_model.h): the closure of a fan's
+ * tip clearance an engine's performance model would hand the contact model, from the spool speed alone
+ * (fmu_src/engine/clearance_interface.py states the model):
+ *
+ *     closure = closure0 + c_centrifugal Omega^2 + d_thermal,   tau dd_thermal/dt = c_thermal Omega^2 - d_thermal
+ *
+ * the centrifugal growth of disk and blades at once, the thermal growth with the lag of the casing's
+ * temperature. With Omega held over a step the lag is integrated exactly (an exponential), so the model has
+ * no step-size error to speak of. The outputs follow the speed held over the last step; before the first,
+ * the declared start value of Omega (the engine's speed before the run, warm there): what an input holds at
+ * initialisation depends on the master (libcosim propagates its connections' initial values, fmpy does
+ * not), the declared start does not.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "fmu_model.h"
+#include "rr_math.h"
+
+/* value references, the order of SPECS in clearance_interface.py (checked at build) */
+enum { VR_OMEGA, VR_CLOSURE0, VR_CC, VR_CT, VR_TAU, VR_CLOSURE, VR_CENTRIFUGAL, VR_THERMAL };
+
+#define STATE_TAG 52170501.0
+
+struct model_runtime {
+    double closure0, cc, ct, tau;
+    double t, d, w; /* time, thermal growth, the speed held over the last step */
+    double advanced;
+};
+
+static void outputs(const model_runtime *m, model_values *v)
+{
+    double w = m->w, c = m->cc * w * w;
+    v->r[VR_CENTRIFUGAL] = c;
+    v->r[VR_THERMAL] = m->d;
+    v->r[VR_CLOSURE] = m->closure0 + c + m->d;
+}
+
+model_runtime *model_configure(const model_values *v, double t0, char *msg, size_t len)
+{
+    model_runtime *m = (model_runtime *)calloc(1, sizeof *m);
+    if (!m) {
+        snprintf(msg, len, "out of memory");
+        return NULL;
+    }
+    m->closure0 = v->r[VR_CLOSURE0];
+    m->cc = v->r[VR_CC];
+    m->ct = v->r[VR_CT];
+    m->tau = v->r[VR_TAU];
+    m->t = t0;
+    m->w = MODEL_INFO.vars[VR_OMEGA].start;
+    m->d = m->ct * m->w * m->w; /* warm at the start speed: the engine ran there */
+    return m;
+}
+
+void model_free(model_runtime *m) { free(m); }
+
+fmi2Status model_check_set(const model_runtime *m, const model_values *v, int vr, double x, char *msg, size_t len)
+{
+    (void)m;
+    (void)v;
+    (void)vr;
+    (void)x;
+    (void)msg;
+    (void)len;
+    return fmi2OK; /* the declared ranges are the only rules */
+}
+
+fmi2Status model_step(model_runtime *m, model_values *v, double t, double h, char *msg, size_t len)
+{
+    double w = v->r[VR_OMEGA], target = m->ct * w * w;
+    (void)msg;
+    (void)len;
+    m->w = w;
+    m->d = target + (m->d - target) * rr_exp(-h / m->tau);
+    m->t = t + h;
+    m->advanced = h;
+    v->i[MODEL_INFO.vr_status] = STATUS_OK;
+    outputs(m, v);
+    return fmi2OK;
+}
+
+fmi2Status model_solve_now(model_runtime *m, model_values *v, double t, char *msg, size_t len)
+{
+    (void)msg;
+    (void)len;
+    m->t = t;
+    outputs(m, v);
+    return fmi2OK;
+}
+
+double model_time_advanced(const model_runtime *m) { return m->advanced; }
+
+/* layout: tag, t, d, w */
+size_t model_state_size(const model_runtime *m)
+{
+    (void)m;
+    return 4;
+}
+
+void model_state_save(const model_runtime *m, double *out)
+{
+    out[0] = STATE_TAG;
+    out[1] = m->t;
+    out[2] = m->d;
+    out[3] = m->w;
+}
+
+int model_state_restore(model_runtime *m, const double *in, size_t count)
+{
+    if (count != 4 || in[0] != STATE_TAG || !isfinite(in[1]) || !isfinite(in[2]) || !isfinite(in[3])) return -1;
+    m->t = in[1];
+    m->d = in[2];
+    m->w = in[3];
+    return 0;
+}
