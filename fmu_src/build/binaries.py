@@ -21,6 +21,30 @@ FMI2_CS_FUNCTIONS = (
 )
 
 
+# every function of the FMI 3.0 API (fmi3Functions.h): the FMU exports them all, the ones it does not provide
+# refusing with fmi3Error and a message
+FMI3_FUNCTIONS = (
+    "fmi3GetVersion", "fmi3SetDebugLogging", "fmi3InstantiateModelExchange", "fmi3InstantiateCoSimulation",
+    "fmi3InstantiateScheduledExecution", "fmi3FreeInstance", "fmi3EnterInitializationMode",
+    "fmi3ExitInitializationMode", "fmi3EnterEventMode", "fmi3Terminate", "fmi3Reset", "fmi3GetFloat32",
+    "fmi3GetFloat64", "fmi3GetInt8", "fmi3GetUInt8", "fmi3GetInt16", "fmi3GetUInt16", "fmi3GetInt32",
+    "fmi3GetUInt32", "fmi3GetInt64", "fmi3GetUInt64", "fmi3GetBoolean", "fmi3GetString", "fmi3GetBinary",
+    "fmi3GetClock", "fmi3SetFloat32", "fmi3SetFloat64", "fmi3SetInt8", "fmi3SetUInt8", "fmi3SetInt16",
+    "fmi3SetUInt16", "fmi3SetInt32", "fmi3SetUInt32", "fmi3SetInt64", "fmi3SetUInt64", "fmi3SetBoolean",
+    "fmi3SetString", "fmi3SetBinary", "fmi3SetClock", "fmi3GetNumberOfVariableDependencies",
+    "fmi3GetVariableDependencies", "fmi3GetFMUState", "fmi3SetFMUState", "fmi3FreeFMUState",
+    "fmi3SerializedFMUStateSize", "fmi3SerializeFMUState", "fmi3DeserializeFMUState", "fmi3GetDirectionalDerivative",
+    "fmi3GetAdjointDerivative", "fmi3EnterConfigurationMode", "fmi3ExitConfigurationMode", "fmi3GetIntervalDecimal",
+    "fmi3GetIntervalFraction", "fmi3GetShiftDecimal", "fmi3GetShiftFraction", "fmi3SetIntervalDecimal",
+    "fmi3SetIntervalFraction", "fmi3SetShiftDecimal", "fmi3SetShiftFraction", "fmi3EvaluateDiscreteStates",
+    "fmi3UpdateDiscreteStates", "fmi3EnterContinuousTimeMode", "fmi3CompletedIntegratorStep", "fmi3SetTime",
+    "fmi3SetContinuousStates", "fmi3GetContinuousStateDerivatives", "fmi3GetEventIndicators",
+    "fmi3GetContinuousStates", "fmi3GetNominalsOfContinuousStates", "fmi3GetNumberOfEventIndicators",
+    "fmi3GetNumberOfContinuousStates", "fmi3EnterStepMode", "fmi3GetOutputDerivatives", "fmi3DoStep",
+    "fmi3ActivateModelPartition",
+)
+
+
 def _cstr(data: bytes, off: int) -> str:
     end = data.index(b"\0", off)
     return data[off:end].decode("ascii", "replace")
@@ -140,6 +164,8 @@ def exported_symbols(path: str | Path) -> list[tuple[str, set[str]]]:
     return [_macho(data)]
 
 
-def missing_fmi_functions(path: str | Path) -> dict[str, list[str]]:
-    """Per architecture, the FMI 2.0 co-simulation functions the binary does not export (empty: all there)."""
-    return {arch: [f for f in FMI2_CS_FUNCTIONS if f not in names] for arch, names in exported_symbols(path)}
+def missing_fmi_functions(path: str | Path, fmi: str = "2.0") -> dict[str, list[str]]:
+    """Per architecture, the FMI 2.0 co-simulation functions (``fmi = "3.0"``: the FMI 3.0 API's) the binary
+    does not export (empty: all there)."""
+    wanted = FMI3_FUNCTIONS if fmi == "3.0" else FMI2_CS_FUNCTIONS
+    return {arch: [f for f in wanted if f not in names] for arch, names in exported_symbols(path)}

@@ -11,6 +11,9 @@ from pathlib import Path
 def _add_build_args(sp: argparse.ArgumentParser) -> None:
     sp.add_argument("--native", action="store_true",
                     help="the native C FMU (no Python on the host) instead of the pythonfmu one")
+    sp.add_argument("--fmi3", action="store_true",
+                    help="with --native: the FMI 3.0 co-simulation FMU (fmus/native-fmi3/: arrays per blade, early "
+                         "return at a first contact) instead of the FMI 2.0 one")
     sp.add_argument("--mode", default="transient", choices=["transient", "quasi_static"],
                     help="default of the mode parameter, and the output dependencies the FMU declares")
     sp.add_argument("--platforms", nargs="+", default=None,
@@ -19,12 +22,24 @@ def _add_build_args(sp: argparse.ArgumentParser) -> None:
 
 
 def build(dest: str | Path, params: str | Path | None = None, native: bool = False, mode: str = "transient",
-          platforms: tuple[str, ...] | None = None) -> dict:
-    """Build one FMU flavour into ``dest`` and write the cross-check kit next to it."""
+          platforms: tuple[str, ...] | None = None, fmi3: bool = False) -> dict:
+    """Build one FMU flavour into ``dest`` and write the cross-check kit next to it (``fmi3``: the native FMI 3.0
+    FMU and its kit)."""
     from rotorub_model.structure.params import load_parameters
 
     from . import crosscheck
 
+    if fmi3 and not native:
+        from .native_fmu import NativeBuildError
+
+        raise NativeBuildError("--fmi3: the FMI 3.0 FMU is the native one: add --native (pythonfmu 0.7 writes FMI "
+                               "2.0 only)")
+    if fmi3:
+        from .native_fmu3 import build_native_fmu3
+
+        out = build_native_fmu3(dest, params, platforms, mode)
+        kit = crosscheck.write_kit(Path(out["fmu"]).parent, load_parameters(params) if params else None, fmi="3.0")
+        return {**out, "crosscheck_kit": sorted(str(p) for p in kit.values())}
     if native:
         from .native_fmu import build_native_fmu
 
@@ -44,15 +59,16 @@ def _run_build(ns: argparse.Namespace) -> dict:
     from .native_fmu import NativeBuildError
     from .pythonfmu_fmu import BuildError
 
-    default = Path("fmus") / ("native" if ns.native else "")
+    default = Path("fmus") / (("native-fmi3" if ns.fmi3 else "native") if ns.native else "")
     dest = default if ns.out == "out/build-fmu" else Path(ns.out)
     try:
-        return build(dest, ns.params, ns.native, ns.mode, tuple(ns.platforms) if ns.platforms else None)
+        return build(dest, ns.params, ns.native, ns.mode, tuple(ns.platforms) if ns.platforms else None, ns.fmi3)
     except (BuildError, NativeBuildError, CompilerError) as exc:
         raise ParameterError(f"build-fmu: {exc}") from None
 
 
 # (name, help, add_arguments, run): what rotorub_model.app.cli registers for each entry point
 BUILD_FMU = ("build-fmu", "package the contact model as an FMI 2.0 co-simulation FMU: fmus/RotorCasingContact.fmu "
-             "(pythonfmu) or, with --native, fmus/native/RotorCasingContact.fmu (C, no Python on the host)",
+             "(pythonfmu) or, with --native, fmus/native/RotorCasingContact.fmu (C, no Python on the host); with "
+             "--native --fmi3, the FMI 3.0 one in fmus/native-fmi3/",
              _add_build_args, _run_build)

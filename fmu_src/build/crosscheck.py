@@ -18,6 +18,7 @@ interpolates inputs linearly gives the same run. The reference comes from the li
 from __future__ import annotations
 
 import csv
+import re
 from pathlib import Path
 
 import numpy as np
@@ -62,15 +63,26 @@ def reference(params=None) -> dict[str, np.ndarray]:
     return out
 
 
-def write_kit(dest: str | Path, params=None) -> dict[str, Path]:
-    """Write the four files of the kit into ``dest`` (next to the FMU)."""
+def column3(name: str) -> str:
+    """A kit column in the FMI 3.0 FMU's names: an element of a per-blade array, blade[j].F_N, is blade.F_N[j]."""
+    m = re.match(r"^blade\[(\d+)\]\.(\w+)$", name)
+    return f"blade.{m.group(2)}[{m.group(1)}]" if m else name
+
+
+def write_kit(dest: str | Path, params=None, fmi: str = "2.0") -> dict[str, Path]:
+    """Write the four files of the kit into ``dest`` (next to the FMU). ``fmi = "3.0"``: the FMI 3.0 FMU's
+    kit, the same run and numbers with the array elements as its columns (blade.F_N[1], ...)."""
     dest = Path(dest)
     dest.mkdir(parents=True, exist_ok=True)
     ref = reference(params)
     files = {"in": dest / f"{NAME}_in.csv", "ref": dest / f"{NAME}_ref.csv", "opt": dest / f"{NAME}_ref.opt",
              "readme": dest / "ReadMe.txt"}
     _write_csv(files["in"], ref, ("time", "Omega", "imbalance"))
-    _write_csv(files["ref"], ref, ("time", *OUTPUTS))
+    if fmi == "3.0":
+        ref = {**ref, **{column3(c): ref[c] for c in OUTPUTS}}
+        _write_csv(files["ref"], ref, ("time", *(column3(c) for c in OUTPUTS)))
+    else:
+        _write_csv(files["ref"], ref, ("time", *OUTPUTS))
     files["opt"].write_text(f"StartTime, 0.0\nStopTime, {RUN['duration']!r}\nStepSize, {RUN['h']!r}\n"
                             "RelTol, 1e-6\n")
     files["readme"].write_text(f"""{NAME}: FMI cross-check kit (co-simulation)
@@ -88,7 +100,13 @@ identical numbers on every platform they were run on (linux64, aarch64-linux und
 wine): the kernel has its own elementary functions. The outputs at t = 0 are those after initialisation.
 
 Reference written by rotorub (fmu_src/build/crosscheck.py) from the library's run_transient(hold=h).
-""")
+""" + ("""
+FMI 3.0: the per-blade outputs are arrays of n_blades elements; column blade.F_N[j] is element j of the
+array blade.F_N (fmi3GetFloat64 of its value reference with nValues = n_blades). Instantiate without early
+return (earlyReturnAllowed = false) to take the communication steps of this table; with early return the
+same run, continued from each early return to the next communication point, gives the same numbers here
+(the step's remainder is a whole number of the same internal substeps).
+""" if fmi == "3.0" else ""))
     return files
 
 

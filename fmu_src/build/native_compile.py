@@ -35,18 +35,19 @@ class NativeBuildError(Exception):
 
 @dataclass(frozen=True)
 class Platform:
-    folder: str  # FMI binaries/ folder
+    folder: str  # FMI 2.0 binaries/ folder (the name every command takes)
     suffix: str
     zig_target: str
     machine: str  # what binaries.exported_symbols reports
+    fmi3_folder: str  # FMI 3.0 binaries/ folder (the standard's platform tuple)
 
 
 PLATFORMS = {p.folder: p for p in (
-    Platform("linux64", ".so", "x86_64-linux-gnu.2.17", "x86_64"),
-    Platform("aarch64-linux", ".so", "aarch64-linux-gnu.2.17", "aarch64"),
-    Platform("win64", ".dll", "x86_64-windows-gnu", "x86_64"),
-    Platform("darwin64", ".dylib", "x86_64-macos", "x86_64"),
-    Platform("aarch64-darwin", ".dylib", "aarch64-macos", "aarch64"),
+    Platform("linux64", ".so", "x86_64-linux-gnu.2.17", "x86_64", "x86_64-linux"),
+    Platform("aarch64-linux", ".so", "aarch64-linux-gnu.2.17", "aarch64", "aarch64-linux"),
+    Platform("win64", ".dll", "x86_64-windows-gnu", "x86_64", "x86_64-windows"),
+    Platform("darwin64", ".dylib", "x86_64-macos", "x86_64", "x86_64-darwin"),
+    Platform("aarch64-darwin", ".dylib", "aarch64-macos", "aarch64", "aarch64-darwin"),
 )}
 ALL_PLATFORMS = tuple(PLATFORMS)
 GLIBC_BASELINE = (2, 17)
@@ -102,10 +103,10 @@ def _cache_dir() -> Path:
 
 
 def compile_platforms(sources: Path, c_files: tuple[str, ...], identifier: str, dest: Path,
-                      platforms: tuple[str, ...] | None, what: str = "native FMU") -> list[str]:
-    """Compile ``sources/c_files`` into ``dest/<platform>/<identifier><suffix>`` for each platform;
-    returns the platforms built. ``platforms=None``: every platform when ziglang is installed, else
-    this machine's only."""
+                      platforms: tuple[str, ...] | None, what: str = "native FMU", fmi: str = "2.0") -> list[str]:
+    """Compile ``sources/c_files`` into ``dest/<platform folder>/<identifier><suffix>`` for each platform;
+    returns the platforms built (by their FMI 2.0 names). ``platforms=None``: every platform when ziglang
+    is installed, else this machine's only. ``fmi``: whose folder names ("2.0": linux64; "3.0": x86_64-linux)."""
     from rotorub_model.kernel.compiler import CFLAGS, Compiler, find_compiler, zig_command
 
     zig = zig_command()
@@ -140,7 +141,7 @@ def compile_platforms(sources: Path, c_files: tuple[str, ...], identifier: str, 
     def one(job) -> str:
         plat, compiler, flags, libs, key = job
         name = f"{identifier}{PLATFORMS[plat].suffix}"
-        out = dest / plat / name
+        out = dest / (PLATFORMS[plat].fmi3_folder if fmi == "3.0" else plat) / name
         out.parent.mkdir(parents=True, exist_ok=True)
         cached = _cache_dir() / key / name
         if cached.exists():

@@ -33,21 +33,23 @@ from .native_compile import NativeBuildError, compile_platforms
 
 HERE = Path(__file__).resolve().parent.parent  # fmu_src/
 NATIVE = HERE / "native"
-WRAPPER = ("fmi2_cs.c", "fmu_model.h")
-C_SOURCES = ("fmi2_cs.c", "contact_model.c", "model_data.c", "rotorub_kernel.c")
+WRAPPER = ("fmi2_cs.c", "fmu_core.c", "fmu_core.h", "fmu_model.h")
+WRAPPER3 = ("fmi3_cs.c", "fmu_core.c", "fmu_core.h", "fmu_model.h", "fmi3_vars.h")
+C_SOURCES = ("fmi2_cs.c", "fmu_core.c", "contact_model.c", "model_data.c", "rotorub_kernel.c")
 FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
+FMI3_HEADERS = ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")
 
 __all__ = ["NativeBuildError", "build_native_fmu", "package_native_fmu", "variable_table"]
 
 
-def fmi_headers() -> Path:
-    """The FMI 2.0 headers of the standard, as fmpy ships them."""
+def fmi_headers(headers: tuple[str, ...] = FMI_HEADERS) -> Path:
+    """The folder of the standard's FMI headers (2.0 by default), as fmpy ships them."""
     try:
         import fmpy
     except ImportError:
-        raise NativeBuildError("the native FMU build takes the FMI 2.0 headers from fmpy: pip install fmpy") from None
+        raise NativeBuildError("the native FMU build takes the FMI headers from fmpy: pip install fmpy") from None
     d = Path(fmpy.__file__).resolve().parent / "c-code"
-    missing = [h for h in FMI_HEADERS if not (d / h).exists()]
+    missing = [h for h in headers if not (d / h).exists()]
     if missing:
         raise NativeBuildError(f"fmpy's FMI headers not found ({', '.join(missing)} in {d})")
     return d
@@ -186,12 +188,14 @@ runtime only (Linux binaries: glibc 2.17 or newer).</p>
 
 def package_native_fmu(out_file: Path, *, identifier: str, variables: list[interface.Var], guid: str,
                        model_sources: dict[str, Path | str], c_files: tuple[str, ...], description_xml: bytes,
-                       documentation: dict[str, Path | str], platforms: tuple[str, ...] | None) -> list[str]:
+                       documentation: dict[str, Path | str], platforms: tuple[str, ...] | None,
+                       fmi: str = "2.0") -> list[str]:
     """Stage a native FMU's sources, compile them for ``platforms`` and zip the FMU into ``out_file``.
 
     ``model_sources``: file name in sources/ -> a path to copy or the text to write (the model's C files
-    and its model_data.c); the wrapper, rr_math.h and the FMI headers are added here. ``documentation``:
-    file name in documentation/ -> a path or a text. Returns the platforms built.
+    and its model_data.c); the wrapper of that FMI version (``fmi``: "2.0" or "3.0"), rr_math.h, the FMI
+    headers and a CMakeLists.txt are added here. ``documentation``: file name in documentation/ -> a path
+    or a text. Returns the platforms built.
     """
     from rotorub_model import kernel
 
@@ -201,15 +205,16 @@ def package_native_fmu(out_file: Path, *, identifier: str, variables: list[inter
         root = Path(tmp) / "fmu"
         src = root / "sources"
         src.mkdir(parents=True)
-        files: dict[str, Path | str] = {**{n: NATIVE / n for n in WRAPPER}, kernel.MATH_HEADER.name: kernel.MATH_HEADER,
-                                        **{n: fmi_headers() / n for n in FMI_HEADERS}, **model_sources,
+        wrapper, headers = (WRAPPER3, FMI3_HEADERS) if fmi == "3.0" else (WRAPPER, FMI_HEADERS)
+        files: dict[str, Path | str] = {**{n: NATIVE / n for n in wrapper}, kernel.MATH_HEADER.name: kernel.MATH_HEADER,
+                                        **{n: fmi_headers(headers) / n for n in headers}, **model_sources,
                                         "CMakeLists.txt": cmakelists(identifier, c_files)}
         for name, what in files.items():
             if isinstance(what, Path):
                 shutil.copy2(what, src / name)
             else:
                 (src / name).write_text(what)
-        built = compile_platforms(src, c_files, identifier, root / "binaries", platforms, what=identifier)
+        built = compile_platforms(src, c_files, identifier, root / "binaries", platforms, what=identifier, fmi=fmi)
         (root / "modelDescription.xml").write_bytes(description_xml)
         doc = root / "documentation"
         doc.mkdir()

@@ -10,7 +10,7 @@ from pathlib import Path
 from . import clearance_interface as ci
 from .system import EngineError
 
-NATIVE_SOURCES = ("fmi2_cs.c", "clearance_model.c", "model_data.c")
+NATIVE_SOURCES = ("fmi2_cs.c", "fmu_core.c", "clearance_model.c", "model_data.c")
 C_ORDER = ("Omega", "closure0", "c_centrifugal", "c_thermal", "tau_thermal", "closure", "closure_centrifugal",
            "closure_thermal")
 

@@ -25,7 +25,7 @@ from .system import SPOOL_ID, EngineError
 HERE = Path(__file__).resolve().parent.parent  # fmu_src/
 SPOOL_SCRIPT = HERE / "pythonfmu" / "spool_slave.py"
 INTERFACE = Path(si.__file__)
-NATIVE_SOURCES = ("fmi2_cs.c", "spool_model.c", "model_data.c")
+NATIVE_SOURCES = ("fmi2_cs.c", "fmu_core.c", "spool_model.c", "model_data.c")
 # the value references spool_model.c reads (its enum), checked against the interface at build
 C_ORDER = ("friction_torque", "J", "c_w", "Omega0", "Omega1", "t_ramp_start", "t_ramp", "dt_max", "Omega",
            "Omega_schedule", "drive_torque", "windage_torque")

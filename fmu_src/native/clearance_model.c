@@ -57,7 +57,7 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
 
 void model_free(model_runtime *m) { free(m); }
 
-fmi2Status model_check_set(const model_runtime *m, const model_values *v, int vr, double x, char *msg, size_t len)
+model_status model_check_set(const model_runtime *m, const model_values *v, int vr, double x, char *msg, size_t len)
 {
     (void)m;
     (void)v;
@@ -65,10 +65,10 @@ fmi2Status model_check_set(const model_runtime *m, const model_values *v, int vr
     (void)x;
     (void)msg;
     (void)len;
-    return fmi2OK; /* the declared ranges are the only rules */
+    return MODEL_OK; /* the declared ranges are the only rules */
 }
 
-fmi2Status model_step(model_runtime *m, model_values *v, double t, double h, char *msg, size_t len)
+model_status model_step(model_runtime *m, model_values *v, double t, double h, char *msg, size_t len)
 {
     double w = v->r[VR_OMEGA], target = m->ct * w * w;
     (void)msg;
@@ -79,16 +79,16 @@ fmi2Status model_step(model_runtime *m, model_values *v, double t, double h, cha
     m->advanced = h;
     v->i[MODEL_INFO.vr_status] = STATUS_OK;
     outputs(m, v);
-    return fmi2OK;
+    return MODEL_OK;
 }
 
-fmi2Status model_solve_now(model_runtime *m, model_values *v, double t, char *msg, size_t len)
+model_status model_solve_now(model_runtime *m, model_values *v, double t, char *msg, size_t len)
 {
     (void)msg;
     (void)len;
     m->t = t;
     outputs(m, v);
-    return fmi2OK;
+    return MODEL_OK;
 }
 
 double model_time_advanced(const model_runtime *m) { return m->advanced; }

@@ -334,8 +334,8 @@ static void wear_outputs(const model_runtime *m, model_values *v)
     v->r[VR_CLEARANCE_EFFECTIVE] = m->g0 - closure + out[RR_WEAR_MEAN];
 }
 
-static fmi2Status transient_step(model_runtime *m, model_values *v, double w, double me, double h, char *msg,
-                                 size_t len)
+static model_status transient_step(model_runtime *m, model_values *v, double w, double me, double h, int to_event,
+                                   int *event, char *msg, size_t len)
 {
     const model_data *d = &MODEL_DATA;
     int n = m->n, i, ns, done;
@@ -343,10 +343,10 @@ static fmi2Status transient_step(model_runtime *m, model_values *v, double w, do
     size_t k, nn = (size_t)n * n;
     if (m->st.diverged) {
         snprintf(msg, len, "the run diverged at t = %.6g s (internal time)", m->st.t);
-        return fmi2Discard;
+        return MODEL_DISCARD;
     }
     ns = substeps(m, w, h, msg, len);
-    if (ns < 1) return fmi2Error;
+    if (ns < 1) return MODEL_ERROR;
     dt = h / ns;
     /* the matrices first: a step refused here leaves the state as it was (the two-step scheme untouched) */
     if (!m->have_mats || m->mats_omega != w || m->mats_dt != dt) {
@@ -354,7 +354,7 @@ static fmi2Status transient_step(model_runtime *m, model_values *v, double w, do
                         m->mwork, m->piv) != 0) {
             m->have_mats = 0; /* the buffers hold a failed build */
             snprintf(msg, len, "the central-difference matrix is singular at %g rad/s, dt = %g s", w, dt);
-            return fmi2Error;
+            return MODEL_ERROR;
         }
         for (k = 0; k < (size_t)n; ++k) m->f[k] = 1.0 * w * w * d->f_unit[k];
         m->have_mats = 1;
@@ -378,6 +378,7 @@ static fmi2Status transient_step(model_runtime *m, model_values *v, double w, do
     m->job.me = me;
     m->job.n_rec = 0;
     m->job.out_dest = v->r;
+    m->job.stop_on_contact = to_event;
     {
         double t0 = m->st.t;
         done = rr_cd_run(&m->job);
@@ -387,17 +388,19 @@ static fmi2Status transient_step(model_runtime *m, model_values *v, double w, do
     wear_outputs(m, v);
     v->r[VR_DT_INTERNAL] = dt;
     v->i[VR_N_SUBSTEPS] = done;
+    *event = done < ns && !m->st.diverged; /* only stop_on_contact ends a run early without a divergence */
+    if (*event) return MODEL_OK;
     if (done < ns || m->st.diverged) {
         snprintf(msg, len, "the run diverged at t = %.6g s (internal time): a blade penetrated the casing deeper "
                  "than max_penetration = %g mm (or the state stopped being finite); the outputs are those of that "
                  "state", m->st.t, m->max_pen * 1e3);
-        return fmi2Discard;
+        return MODEL_DISCARD;
     }
-    return fmi2OK;
+    return MODEL_OK;
 }
 
 /* the balanced static solution at (w, me) and its stability; outputs at frame angle phi */
-static fmi2Status static_solution(model_runtime *m, model_values *v, double w, double me, double phi, char *msg,
+static model_status static_solution(model_runtime *m, model_values *v, double w, double me, double phi, char *msg,
                                   size_t len)
 {
     const model_data *d = &MODEL_DATA;
@@ -414,7 +417,7 @@ static fmi2Status static_solution(model_runtime *m, model_values *v, double w, d
     if (!ok) {
         snprintf(msg, len, "no balanced static solution at Omega = %g rad/s, imbalance = %g kg.m, g0 = %g m "
                  "(relative residual %.2e); the outputs hold the last solution", w, me, m->g0, rel);
-        return fmi2Discard;
+        return MODEL_DISCARD;
     }
     /* x' = A x, x = (q, q'): A = [[0, I], [-M^-1 (K(W) - J), -M^-1 (D + W G1 - Jv)]] */
     rr_jacobian(&m->contact, q, NULL, w, J, m->Jv);
@@ -440,7 +443,7 @@ static fmi2Status static_solution(model_runtime *m, model_values *v, double w, d
     }
     if (rr_eigenvalues(2 * n, A, m->wr, m->wi, m->ework) != 0) {
         snprintf(msg, len, "the eigenvalues of the linearised system did not converge at Omega = %g rad/s", w);
-        return fmi2Discard;
+        return MODEL_DISCARD;
     }
     for (i = 0; i < 2 * n; ++i)
         if (m->wr[i] > max_real) max_real = m->wr[i];
@@ -459,44 +462,59 @@ static fmi2Status static_solution(model_runtime *m, model_values *v, double w, d
         snprintf(msg, len, "the balanced solution at Omega = %g rad/s, imbalance = %g kg.m, g0 = %g mm penetrates "
                  "the casing by %.4g mm, deeper than max_penetration = %g mm: a divergence (the outputs are that "
                  "solution's)", w, me, m->g0 * 1e3, -gmin * 1e3, m->max_pen * 1e3);
-        return fmi2Discard;
+        return MODEL_DISCARD;
     }
     v->i[MODEL_INFO.vr_status] = max_real > RE_TOL ? STATUS_UNSTABLE : STATUS_OK;
-    return fmi2OK;
+    return MODEL_OK;
 }
 
-fmi2Status model_check_set(const model_runtime *m, const model_values *v, int vr, double x, char *msg, size_t len)
+model_status model_check_set(const model_runtime *m, const model_values *v, int vr, double x, char *msg, size_t len)
 {
     (void)v;
     if (vr == VR_G0 && x < -m->max_pen) {
         snprintf(msg, len, "g0 = %.6g mm: an interference deeper than max_penetration = %.6g mm is a divergence "
                  "(accepted: g0 >= -max_penetration)", x * 1e3, m->max_pen * 1e3);
-        return fmi2Error;
+        return MODEL_ERROR;
     }
-    return fmi2OK;
+    return MODEL_OK;
 }
 
-fmi2Status model_step(model_runtime *m, model_values *v, double t, double h, char *msg, size_t len)
+static model_status step(model_runtime *m, model_values *v, double h, int to_event, int *event, char *msg, size_t len)
 {
     double w = v->r[VR_OMEGA], me = v->r[VR_IMBALANCE], g0 = v->r[VR_G0];
-    fmi2Status s;
-    (void)t; /* autonomous */
+    model_status s;
     m->advanced = 0.0;
+    *event = 0;
     if (g0 != m->g0) set_clearance(m, g0);
     if (m->mode == MODE_TRANSIENT) {
-        s = transient_step(m, v, w, me, h, msg, len);
-        if (s == fmi2OK) v->i[MODEL_INFO.vr_status] = STATUS_OK;
+        s = transient_step(m, v, w, me, h, to_event, event, msg, len);
+        if (s == MODEL_OK) v->i[MODEL_INFO.vr_status] = STATUS_OK;
         return s;
     }
     s = static_solution(m, v, w, me, m->phi_qs + w * h, msg, len);
-    if (s == fmi2OK) {
+    if (s == MODEL_OK) {
         m->phi_qs += w * h;
         m->advanced = h;
     }
     return s;
 }
 
-fmi2Status model_solve_now(model_runtime *m, model_values *v, double t, char *msg, size_t len)
+model_status model_step(model_runtime *m, model_values *v, double t, double h, char *msg, size_t len)
+{
+    int event;
+    (void)t; /* autonomous */
+    return step(m, v, h, 0, &event, msg, len);
+}
+
+/* quasi_static: a balanced solution has no time inside the step, so no event either */
+model_status model_step_to_event(model_runtime *m, model_values *v, double t, double h, int *event, char *msg,
+                                 size_t len)
+{
+    (void)t;
+    return step(m, v, h, m->mode == MODE_TRANSIENT, event, msg, len);
+}
+
+model_status model_solve_now(model_runtime *m, model_values *v, double t, char *msg, size_t len)
 {
     double g0 = v->r[VR_G0];
     (void)t;
@@ -507,7 +525,7 @@ fmi2Status model_solve_now(model_runtime *m, model_values *v, double t, char *ms
         rr_outputs(&m->contact, m->q, NULL, v->r[VR_OMEGA], m->st.phi, OUTPUT_INDEX, v->r);
         finish_outputs(v, 0.0);
         wear_outputs(m, v);
-        return fmi2OK;
+        return MODEL_OK;
     }
     return static_solution(m, v, v->r[VR_OMEGA], v->r[VR_IMBALANCE], m->phi_qs, msg, len);
 }

@@ -81,7 +81,7 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
 
 void model_free(model_runtime *m) { free(m); }
 
-fmi2Status model_check_set(const model_runtime *m, const model_values *v, int vr, double x, char *msg, size_t len)
+model_status model_check_set(const model_runtime *m, const model_values *v, int vr, double x, char *msg, size_t len)
 {
     (void)m;
     (void)v;
@@ -89,7 +89,7 @@ fmi2Status model_check_set(const model_runtime *m, const model_values *v, int vr
     (void)x;
     (void)msg;
     (void)len;
-    return fmi2OK; /* the declared ranges are the only rules */
+    return MODEL_OK; /* the declared ranges are the only rules */
 }
 
 static double rhs(const model_runtime *m, double s, double e, double tau)
@@ -99,7 +99,7 @@ static double rhs(const model_runtime *m, double s, double e, double tau)
     return (tau - m->cw * e * (2.0 * ws + e)) / m->J;
 }
 
-fmi2Status model_step(model_runtime *m, model_values *v, double t, double h, char *msg, size_t len)
+model_status model_step(model_runtime *m, model_values *v, double t, double h, char *msg, size_t len)
 {
     double tau = v->r[VR_TAU], e = m->e, ds, ws, wsd, w;
     double nd = rr_ceil(h / m->dt_max * (1.0 - 1e-12));
@@ -109,7 +109,7 @@ fmi2Status model_step(model_runtime *m, model_values *v, double t, double h, cha
         snprintf(msg, len, "communication step h = %.17g s needs %.3g substeps of at most dt_max = %.17g s; at most "
                  "%d are taken in one step (h <= %.17g s); step refused, state unchanged", h, nd, m->dt_max,
                  MODEL_MAX_SUBSTEPS, MODEL_MAX_SUBSTEPS * m->dt_max);
-        return fmi2Error;
+        return MODEL_ERROR;
     }
     n = nd < 1.0 ? 1 : (int)nd;
     ds = h / n;
@@ -128,23 +128,23 @@ fmi2Status model_step(model_runtime *m, model_values *v, double t, double h, cha
         v->i[MODEL_INFO.vr_status] = STATUS_DIVERGED; /* 1: the spool stopped */
         snprintf(msg, len, "the spool would stop (Omega = %g rad/s at the end of the step, friction_torque = %g N.m); "
                  "step refused, state unchanged", w, tau);
-        return fmi2Discard;
+        return MODEL_DISCARD;
     }
     m->e = e;
     m->t = t + h;
     m->advanced = h;
     v->i[MODEL_INFO.vr_status] = STATUS_OK;
     outputs(m, v);
-    return fmi2OK;
+    return MODEL_OK;
 }
 
-fmi2Status model_solve_now(model_runtime *m, model_values *v, double t, char *msg, size_t len)
+model_status model_solve_now(model_runtime *m, model_values *v, double t, char *msg, size_t len)
 {
     (void)msg;
     (void)len;
     m->t = t;
     outputs(m, v);
-    return fmi2OK;
+    return MODEL_OK;
 }
 
 double model_time_advanced(const model_runtime *m) { return m->advanced; }

@@ -31,7 +31,7 @@ SOURCES = (HERE / "rotorub_kernel.c",)
 HEADER = HERE / "rotorub_kernel.h"
 MATH_HEADER = HERE / "rr_math.h"  # the elementary functions: the same bits on every platform
 HEADERS = (HEADER, MATH_HEADER)
-ABI_VERSION = 6
+ABI_VERSION = 7
 LAW_WIDTH = 7
 OUT_BLADE_BLOCKS = 6
 OUT_GLOBALS = 8
@@ -95,7 +95,7 @@ class RRJob(ctypes.Structure):
                 ("t_ramp", ctypes.c_double), ("rec_every", ctypes.c_int), ("rec_cap", ctypes.c_int),
                 ("n_rec", ctypes.c_int), ("rec_q", _dp), ("rec_out", _dp), ("out_index", _ip), ("out_dest", _dp),
                 ("done", ctypes.c_int), ("rec_wear_every", ctypes.c_int), ("rec_wear_cap", ctypes.c_int),
-                ("n_rec_wear", ctypes.c_int), ("rec_wear", _dp)]
+                ("n_rec_wear", ctypes.c_int), ("rec_wear", _dp), ("stop_on_contact", ctypes.c_int)]
 
 
 def source_id() -> str:

@@ -716,12 +716,15 @@ int rr_cd_run(rr_cd_job *job)
     const double omega = job->omega;
     const long long step0 = s->steps;
     rr_surface *sf = c->surface;
+    int open = 1;
     job->done = 0;
     if (s->diverged) return 0;
     if (sf) sf->phi = s->phi; /* the surface is read, and cut, at the state's angle */
     gaps_of(c, q, gaps);
     laws_of(c, gaps, law);
     friction_of(c, law, omega, NULL, q, qp, dt, fr);
+    for (k = 0; k < rows; ++k)
+        if (gaps[k] < 0.0) open = 0;
     for (i = 0; i < job->n_steps; ++i) {
         double t = t0 + i * dt;
         double r = (t_ramp <= 0.0 || t >= t_ramp) ? 1.0 : t / t_ramp;
@@ -764,6 +767,13 @@ int rr_cd_run(rr_cd_job *job)
             if (job->rec_out)
                 outputs_from_law(c, q, gaps, law, fr, 0.0, NULL, job->rec_out + (size_t)written * RR_N_OUT(nb));
             ++written;
+        }
+        if (job->stop_on_contact) {
+            int was_open = open;
+            open = 1;
+            for (k = 0; k < rows; ++k)
+                if (gaps[k] < 0.0) open = 0;
+            if (was_open && !open) break;
         }
     }
     if (!s->diverged) { /* the state the last substep reached counts too: a step ends inside the limit or diverged */

@@ -50,7 +50,7 @@ extern "C" {
 #endif
 
 /* Bumped whenever a struct layout or a signature below changes. */
-#define RR_ABI_VERSION 6
+#define RR_ABI_VERSION 7
 
 /* Per-blade law values (rr_laws): F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction. */
 #define RR_LAW_WIDTH 7
@@ -249,6 +249,10 @@ typedef struct {
      * state->steps), into rec_wear (rec_wear_cap rows of n_sectors) from row n_rec_wear (in/out) */
     int rec_wear_every, rec_wear_cap, n_rec_wear;
     double *rec_wear;
+    /* 1: end the run after the first step that brings a gap below 0 from a state with none (a first contact:
+     * an FMI 3.0 event), done < n_steps then and state->diverged unset; 0: run every step. The steps taken are
+     * those of a run of done steps, bit for bit. */
+    int stop_on_contact;
 } rr_cd_job;
 
 /* Advance job->n_steps central-difference steps at constant matrices, external force

@@ -1,0 +1,466 @@
+"""The contact model as an FMI 3.0 co-simulation FMU (issue 20): the FMI 2.0 native FMU's model and kernel behind
+fmi3_cs.c, driven by fmpy's FMU3Slave.
+
+* the model description passes fmpy's FMI 3.0 validation, with the FMI 2.0 interface's units, ranges and nominal
+  values, the per-blade outputs as arrays of n_blades (a structural parameter) and two event indicators;
+* the cross-check kit's run-up equals the FMI 2.0 native FMU's (same steps, no early return) to 1e-12; with
+  early return the first contact is reported within one internal substep after a bisection of the FMI 2.0 FMU's
+  communication step with rollbacks finds it;
+* the divergence rule, FMU states and their serialisation;
+* every misuse refused with fmi3Error and a logged message, the instance left as it was.
+
+Skips (does not fail) where fmpy has no FMI 3.0 support or no C compiler is there to build the FMU.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import math
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+fmpy = pytest.importorskip("fmpy")
+
+from fmu_src.harness import fmi3_run  # noqa: E402
+
+_why = fmi3_run.fmi3_available()
+if _why:
+    pytest.skip(_why, allow_module_level=True)
+
+from fmpy.fmi3 import fmi3Float64, fmi3Int32, fmi3Int64, fmi3UInt64, fmi3ValueReference  # noqa: E402
+
+from fmu_src import interface  # noqa: E402
+from fmu_src.build import crosscheck  # noqa: E402
+from fmu_src.harness.fmi3_run import DISCARD, ERROR, OK, WARNING, Slave3  # noqa: E402
+
+START = {"g0": 0.2e-3, "Omega": 176.2, "imbalance": 0.022}
+DIVERGES = {**START, "max_penetration": 0.2e-3}  # rubs beyond 0.2 mm at about 0.08 s
+
+
+def _compiler_or_skip() -> None:
+    from rotorub_model.kernel.compiler import CompilerError, find_compiler, zig_command
+
+    if zig_command():
+        return
+    try:
+        find_compiler()
+    except CompilerError as exc:
+        pytest.skip(f"no C compiler to build the FMU: {exc}")
+
+
+@pytest.fixture(scope="module")
+def built3(tmp_path_factory):
+    """`rotorub build-fmu --native --fmi3` (linux64): the FMU and its cross-check kit."""
+    _compiler_or_skip()
+    from fmu_src.build.commands import build
+
+    out = build(tmp_path_factory.mktemp("fmi3"), native=True, fmi3=True, platforms=("linux64",))
+    return out
+
+
+@pytest.fixture(scope="module")
+def fmu3(built3):
+    return built3["fmu"]
+
+
+@pytest.fixture(scope="module")
+def unzipped3(fmu3, tmp_path_factory):
+    d = tmp_path_factory.mktemp("fmi3_unzipped")
+    with zipfile.ZipFile(fmu3) as z:
+        z.extractall(d)
+    return d
+
+
+@pytest.fixture
+def inst(unzipped3):
+    i = Slave3(None, unzipped=str(unzipped3))
+    yield i
+    i.free()
+
+
+def _vals(ctype, values):
+    return (ctype * len(values))(*values), len(values)
+
+
+def _vrs(*vrs):
+    return (fmi3ValueReference * len(vrs))(*vrs), len(vrs)
+
+
+# ------------------------------------------------------------------------------------------ model description
+def test_fmpy_validation_is_clean(fmu3):
+    from fmpy.validation import validate_fmu
+
+    assert validate_fmu(fmu3) == []
+
+
+def test_variables_are_the_fmi2_interface_with_arrays(unzipped3):
+    from fmpy import read_model_description
+
+    md = read_model_description(str(unzipped3))
+    assert md.fmiVersion == "3.0"
+    cs = md.coSimulation
+    assert cs.mightReturnEarlyFromDoStep and not cs.hasEventMode and not cs.providesIntermediateUpdate
+    xml = (unzipped3 / "modelDescription.xml").read_text()
+    assert 'canGetAndSetFMUState="true"' in xml and 'canSerializeFMUState="true"' in xml
+    v3 = {v.name: v for v in md.modelVariables}
+    from rotorub_model.structure.params import reference_parameters
+
+    d = interface.Defaults.from_parameters(reference_parameters())
+    v2 = interface.variables(d, flavour="native")
+    nb = v3["n_blades"]
+    assert (nb.type, nb.causality, nb.variability, int(nb.start)) == ("UInt64", "structuralParameter", "fixed", 10)
+    for quantity in ("F_N", "F_T", "gap_LE", "gap_TE", "gap_tip", "contact_fraction"):
+        a = v3[f"blade.{quantity}"]
+        assert a.type == "Float64" and a.causality == "output"
+        assert [dim.variable for dim in a.dimensions] == [nb] and a.shape == (10,)
+        assert a.valueReference == next(v.vr for v in v2 if v.name == f"blade[1].{quantity}")
+    assert v3["wear.harmonic"].shape == (interface.WEAR_HARMONICS,)
+    types = {"Real": "Float64", "Integer": "Int32", "Enumeration": "Enumeration", "String": "String"}
+    scalars = [v for v in v2 if not v.name.startswith(("blade[", "wear.harmonic["))]
+    assert len(v3) == len(scalars) + 7 + 3  # the 7 arrays, time, n_blades, penetration_margin
+    for v in scalars:  # same name, value reference, type, units, range, nominal and start as FMI 2.0
+        w = v3[v.name]
+        assert (w.valueReference, w.type, w.causality) == (v.vr, types[v.type], v.causality), v.name
+        assert (w.unit, w.displayUnit) == (v.unit, v.display_unit), v.name
+        for key in ("min", "max", "nominal"):
+            want = getattr(v, key)
+            assert (getattr(w, key) is None) == (want is None), (v.name, key)
+            if want is not None:
+                assert float(getattr(w, key)) == float(want), (v.name, key)
+        if v.settable and v.type != "String":
+            assert float(w.start) == float(v.start), v.name
+    assert v3["formulation"].declaredType.name == "Formulation"
+    assert [v3[n].variability for n in ("time", "penetration_margin")] == ["continuous", "continuous"]
+    assert [e.variable.name for e in md.eventIndicators] == ["gap_min", "penetration_margin"]
+    assert md.outputs and all(u.dependencies == [] for u in md.outputs)  # transient: no feedthrough
+
+
+def test_sources_binaries_and_the_same_model(unzipped3, native_fmu):
+    from fmu_src.build.binaries import missing_fmi_functions, newest_glibc
+
+    src = unzipped3 / "sources"
+    bd = (src / "buildDescription.xml").read_text()
+    for f in ("fmi3_cs.c", "fmu_core.c", "contact_model.c", "model_data.c", "rotorub_kernel.c"):
+        assert f'<SourceFile name="{f}"/>' in bd and (src / f).is_file()
+        assert f in (src / "CMakeLists.txt").read_text()
+    so = unzipped3 / "binaries" / "x86_64-linux" / "RotorCasingContact.so"
+    assert missing_fmi_functions(so, "3.0") == {"x86_64": []}
+    assert newest_glibc(so) <= (2, 17)
+    with zipfile.ZipFile(native_fmu) as z:  # one model: the FMI 2.0 FMU's files, byte for byte
+        for f in ("contact_model.c", "fmu_core.c", "fmu_model.h", "rotorub_kernel.c"):
+            assert z.read(f"sources/{f}") == (src / f).read_bytes(), f
+
+
+# ------------------------------------------------------------------------------------------ numbers
+def test_kit_run_up_equals_the_fmi2_fmu(built3, fmu3, native_fmu):
+    """The cross-check kit's run-up (through the first critical with rub), same steps, no early return: the
+    FMI 3.0 FMU's outputs are the FMI 2.0 native FMU's to 1e-12 (and its kit, in FMI 3.0 columns, the
+    reference's to the kit's bound)."""
+    kit = Path(built3["fmu"]).parent
+    r3 = fmi3_run.run_kit(fmu3, kit)
+    r2 = crosscheck.run_fmpy(native_fmu, kit)
+    assert r3["n_contact"].max() >= 1 and r3["gap_min"].min() < 0.0  # it rubs
+    diff = max(float(np.abs(r3[c] - r2[c]).max()) for c in crosscheck.OUTPUTS)
+    assert diff <= 1e-12, diff
+    ref = crosscheck.read_csv(kit / f"{crosscheck.NAME}_ref.csv")
+    assert "blade.F_N[1]" in ref and "blade[1].F_N" not in ref
+    for c in crosscheck.OUTPUTS:
+        scale = max(float(np.abs(ref[crosscheck.column3(c)]).max()), 1e-300)
+        assert float(np.abs(r3[c] - ref[crosscheck.column3(c)]).max()) / scale <= 1e-9, c
+
+
+def test_a_run_with_early_returns_continues_as_without_to_round_off(unzipped3):
+    """After an early return the master steps on to its communication point: the remainder is the same internal
+    substep up to the rounding of the master's subtraction (here 0.0005000000000000004 for 0.0005), and where it
+    differs in the last bits the two-step scheme restarts at the same velocity. So the run departs from the run
+    without early return by round-off only: measured 1.3e-12 of the largest force over 2 s (bound: 1e-11)."""
+    with Slave3(None, unzipped=str(unzipped3), early_return=True) as i, \
+            Slave3(None, unzipped=str(unzipped3), name="plain") as plain:
+        assert i.init(**START) == OK and plain.init(**START) == OK
+        early_returns, worst = 0, 0.0
+        for _ in range(2000):
+            t = i.t
+            s, _, early, last = i.step(1e-3)
+            if early:
+                early_returns += 1
+                s, _, early, _ = i.step(t + 1e-3 - last, last)
+            assert s == OK and not early and plain.step(1e-3)[0] == OK
+            fa, fb = i.get("blade.F_N"), plain.get("blade.F_N")
+            worst = max(worst, float(np.abs(fa - fb).max()) / max(float(np.abs(fb).max()), 1.0))
+        assert early_returns >= 1 and np.abs(fb).max() > 100.0
+        assert worst <= 1e-11, worst
+
+
+@pytest.mark.parametrize("h", [1e-3, 1e-2])
+def test_first_contact_within_one_substep_of_a_bisection_on_the_fmi2_fmu(fmu3, native_fmu, h):
+    """Early return at the first contact: lastSuccessfulTime is the end of the first internal substep whose state
+    is in contact, so a master's bisection of the FMI 2.0 FMU's communication step (rollbacks, to 1e-9 s) finds
+    the crossing within that substep: 0 <= t_fmi3 - t_bisection <= dt_internal."""
+    a = fmi3_run.first_contact_fmi3(fmu3, h, 1.0, **START)
+    b = fmi3_run.first_contact_fmi2_bisection(native_fmu, h, 1.0, tol=1e-9, **START)
+    assert a["gap_min"] < 0.0 and a["n_contact"] >= 1
+    assert a["t_step"] == pytest.approx(b["t_step"], abs=1e-12) and a["t"] < a["t_step"] + h  # early, same step
+    assert 0.0 <= a["t"] - b["t"] <= a["dt_internal"] + 1e-12, (a, b)
+
+
+def test_early_return_protocol(unzipped3):
+    """earlyReturn, lastSuccessfulTime and the next communication point after an early return; a step from
+    anywhere else is refused; without early return allowed the same run never returns early."""
+    with Slave3(None, unzipped=str(unzipped3), early_return=True) as i, \
+            Slave3(None, unzipped=str(unzipped3), name="plain") as plain:
+        assert i.init(**START) == OK and plain.init(**START) == OK
+        t, early = 0.0, False
+        while not early:
+            t = i.t
+            s, term, early, last = i.step(1e-3)
+            assert s == OK and not term
+            assert plain.step(1e-3)[:3] == (OK, False, False)
+        assert t < last < t + 1e-3 and i.get("time") == last and i.get("gap_min") < 0.0
+        assert i.get("n_substeps") == 1 and last == pytest.approx(t + i.get("dt_internal"), abs=1e-15)
+        n = len(i.messages)
+        assert i.step(1e-3, t + 1e-3)[0] == ERROR and "does not match the FMU's time" in i.logged(n)
+        s, _, early, last2 = i.step(t + 1e-3 - last, last)  # on to the communication point
+        assert s == OK and not early and last2 == pytest.approx(t + 1e-3, abs=1e-15)
+
+
+# ------------------------------------------------------------------------------------------ divergence, states
+def test_divergence_discards_terminates_and_rolls_back(inst):
+    assert inst.init(**DIVERGES) == OK
+    state = ctypes.c_void_p()
+    for k in range(2000):
+        if k % 50 == 0:
+            assert inst.call("fmi3GetFMUState", ctypes.byref(state)) == OK
+            t_saved = inst.t
+        t0 = inst.t
+        s, term, early, last = inst.step()
+        if s != OK:
+            break
+    assert s == DISCARD and term and not early and t0 <= last <= t0 + 1e-3
+    assert inst.get("status") == 1 and "max_penetration" in inst.get("message")
+    assert inst.get("penetration_margin") < 0.0  # the divergence's event indicator crossed 0
+    assert "terminateSimulation = true" in inst.logged(level=DISCARD)
+    n = len(inst.messages)
+    assert inst.step(1e-3, last)[0] == ERROR and "ended this simulation" in inst.logged(n)
+    assert inst.set(Omega=100.0) == ERROR and "roll back with fmi3SetFMUState first" in inst.logged(n)
+    assert inst.call("fmi3SetFMUState", state) == OK
+    inst.t = t_saved
+    assert inst.set(g0=5e-3) == OK
+    for _ in range(100):
+        s, term, _, _ = inst.step()
+        assert s == OK and not term
+    assert inst.call("fmi3FreeFMUState", ctypes.byref(state)) == OK
+
+
+def test_serialized_state_continues_bit_for_bit_in_a_fresh_instance(inst):
+    assert inst.init(formulation=1, **START) == OK
+    for _ in range(100):
+        assert inst.step()[0] == OK
+    state = inst.f.getFMUState()
+    data = inst.f.serializeFMUState(state)
+    inst.f.freeFMUState(state)
+    with Slave3(None, unzipped=inst.unzipped, name="fresh") as b:
+        s2 = b.f.deserializeFMUState(data)
+        b.f.setFMUState(s2)  # right after instantiation: the state brings its model (2D)
+        b.t = inst.t
+        assert b.get("formulation") == 1
+        for _ in range(100):
+            assert inst.step()[0] == OK and b.step()[0] == OK
+            assert np.array_equal(inst.get("blade.F_N"), b.get("blade.F_N"))
+        assert inst.get("blade.F_N").max() > 10.0
+        b.f.freeFMUState(s2)
+
+
+# ------------------------------------------------------------------------------------------ misuse: fmi3Error
+def _same_after(inst, probe):
+    """The values a refusal must leave as they were."""
+    return {n: inst.get(n) for n in probe}
+
+
+PROBE = ("Omega", "imbalance", "g0", "mu", "formulation", "n_sectors", "status")
+
+
+@pytest.mark.parametrize("name, value", [
+    ("Omega", -1.0), ("Omega", 1e4), ("Omega", float("nan")), ("imbalance", float("inf")), ("g0", -0.02),
+    ("mu", -0.1), ("theta", math.pi / 2), ("formulation", 3), ("mode", 0), ("n_sectors", 2)])
+def test_out_of_range_value_is_refused(inst, name, value):
+    assert inst.call("fmi3EnterInitializationMode", False, 0.0, 0.0, False, 0.0) == OK
+    before = _same_after(inst, [p for p in PROBE if p != "status"])
+    n = len(inst.messages)
+    assert inst.set(**{name: value}) == ERROR
+    said = inst.logged(n)
+    assert name in said and "accepted range" in said, said
+    assert _same_after(inst, before) == before
+    assert inst.call("fmi3ExitInitializationMode") == OK and inst.step()[0] == OK  # goes on with the old value
+
+
+@pytest.mark.parametrize("fn, name, ctype, value, says", [
+    ("fmi3SetInt32", "Omega", fmi3Int32, 100, "Omega (value reference 0) is of type Float64: use fmi3GetFloat64"),
+    ("fmi3SetFloat64", "n_sectors", fmi3Float64, 100.0, "n_sectors (value reference"),
+    ("fmi3SetInt32", "formulation", fmi3Int32, 1, "is of type Enumeration: use fmi3GetInt64/fmi3SetInt64"),
+    ("fmi3SetFloat32", "Omega", ctypes.c_float, 100.0, "is of type Float64, not Float32"),
+    ("fmi3SetBoolean", "g0", ctypes.c_bool, True, "this FMU has no Boolean variable"),
+    ("fmi3SetUInt64", "Omega", fmi3UInt64, 100, "is of type Float64")])
+def test_wrong_type_is_refused(inst, fn, name, ctype, value, says):
+    assert inst.call("fmi3EnterInitializationMode", False, 0.0, 0.0, False, 0.0) == OK
+    before = _same_after(inst, PROBE)
+    n = len(inst.messages)
+    vrs, nvr = _vrs(inst.vr[name])
+    vals, nv = _vals(ctype, [value])
+    assert inst.call(fn, vrs, nvr, vals, nv) == ERROR
+    assert says in inst.logged(n), inst.logged(n)
+    before["status"] = 2  # the status output says: bad input
+    assert _same_after(inst, PROBE) == before
+
+
+def test_wrong_getter_and_unknown_value_reference_are_refused(inst):
+    assert inst.init(**START) == OK
+    n = len(inst.messages)
+    vrs, nvr = _vrs(inst.vr["n_contact"])
+    out = (fmi3Float64 * 1)()
+    assert inst.call("fmi3GetFloat64", vrs, nvr, out, 1) == ERROR
+    assert "n_contact" in inst.logged(n) and "Int32" in inst.logged(n)
+    vrs, nvr = _vrs(4)  # the gap the pythonfmu flavour's param_file keeps in FMI 2.0
+    assert inst.call("fmi3GetFloat64", vrs, nvr, out, 1) == ERROR and "unknown value reference 4" in inst.logged(n)
+    assert inst.step()[0] == OK
+
+
+def test_array_size_must_match_nvalues(inst):
+    """nValues is the number of elements of the value references given: an array of 10 read with 5 (or 11), two
+    scalars set with one value: refused, nothing read or stored."""
+    assert inst.init(**START) == OK
+    for _ in range(40):
+        inst.step()
+    n = len(inst.messages)
+    fn_vr = inst.vr["blade.F_N"]
+    for count in (5, 11, 1):
+        vrs, nvr = _vrs(fn_vr)
+        out = (fmi3Float64 * count)(*([-7.0] * count))
+        assert inst.call("fmi3GetFloat64", vrs, nvr, out, count) == ERROR
+        assert f"nValues = {count}" in inst.logged(n) and "10 element(s)" in inst.logged(n)
+        assert list(out) == [-7.0] * count  # nothing written
+    vrs, nvr = _vrs(fn_vr, inst.vr["gap_min"])
+    out = (fmi3Float64 * 11)()
+    assert inst.call("fmi3GetFloat64", vrs, nvr, out, 11) == OK and list(out)[:10] == list(inst.get("blade.F_N"))
+    vrs, nvr = _vrs(inst.vr["Omega"], inst.vr["imbalance"])
+    vals, _ = _vals(fmi3Float64, [150.0, 0.01])
+    assert inst.call("fmi3SetFloat64", vrs, nvr, vals, 1) == ERROR and "nValues = 1" in inst.logged(n)
+    assert inst.get("Omega") == START["Omega"]  # all or nothing: the first value was not stored either
+    assert inst.step()[0] == OK
+
+
+def test_calls_in_the_wrong_state_are_refused(inst):
+    n = len(inst.messages)
+    assert inst.step()[0] == ERROR and "the instance is in instantiated" in inst.logged(n)
+    assert inst.call("fmi3Terminate") == ERROR
+    assert inst.call("fmi3EnterEventMode") == ERROR and "hasEventMode = false" in inst.logged(n)
+    assert inst.set(n_blades=10) == ERROR and "configuration mode" in inst.logged(n)
+    assert inst.call("fmi3EnterConfigurationMode") == OK
+    assert inst.set(n_blades=10) == OK  # its one value
+    assert inst.set(n_blades=24) == ERROR and "rebuild" in inst.logged(n) and "[10, 10]" in inst.logged(n)
+    assert inst.set(Omega=100.0) == ERROR and "only structural parameters" in inst.logged(n)
+    assert inst.call("fmi3EnterInitializationMode", False, 0.0, 0.0, False, 0.0) == ERROR
+    assert inst.call("fmi3ExitConfigurationMode") == OK
+    assert inst.call("fmi3EnterInitializationMode", False, 0.0, 0.0, False, 0.0) == OK
+    assert inst.call("fmi3EnterInitializationMode", False, 0.0, 0.0, False, 0.0) == ERROR
+    assert inst.call("fmi3Terminate") == ERROR and "fmi3Reset or fmi3FreeInstance" in inst.logged(n)
+    assert inst.set(**START) == OK and inst.call("fmi3ExitInitializationMode") == OK
+    assert inst.set(k_r=2e6) == ERROR and "fixed parameter" in inst.logged(n)
+    assert inst.set(**{"blade.F_N": [1.0] * 10}) == ERROR and "is an output" in inst.logged(n)
+    assert inst.set(time=1.0) == ERROR and "independent variable" in inst.logged(n)
+    assert inst.step(1e12)[0] == ERROR and "at most 10000000 are taken in one step" in inst.logged(n)
+    assert inst.step()[0] == OK  # every refusal left the instance as it was
+    assert inst.call("fmi3Terminate") == OK
+    assert inst.step(1e-3, inst.t)[0] == ERROR and "terminated" in inst.logged(n)
+
+
+def test_instantiation_refusals_are_logged(unzipped3):
+    from fmpy import read_model_description
+    from fmpy.fmi3 import FMU3Slave
+
+    md = read_model_description(str(unzipped3))
+    got: list[str] = []
+
+    def log(_env, _status, _cat, msg):
+        got.append(msg.decode())
+
+    f = FMU3Slave(guid=md.guid, unzipDirectory=str(unzipped3), modelIdentifier="RotorCasingContact",
+                  instanceName="x")
+    with pytest.raises(Exception, match="instantiate"):
+        f.instantiate(eventModeUsed=True, logMessage=log)
+    assert "no event mode" in got[-1]
+    f = FMU3Slave(guid="{not-this-one}", unzipDirectory=str(unzipped3), modelIdentifier="RotorCasingContact",
+                  instanceName="x")
+    with pytest.raises(Exception, match="instantiate"):
+        f.instantiate(logMessage=log)
+    assert "{not-this-one}" in got[-1] and md.guid in got[-1]
+
+
+def test_enumeration_through_int64_and_messages_shortest_decimals(inst):
+    assert inst.call("fmi3EnterInitializationMode", False, 0.0, 0.0, False, 0.0) == OK
+    vrs, nvr = _vrs(inst.vr["formulation"])
+    vals, nv = _vals(fmi3Int64, [1])
+    assert inst.call("fmi3SetInt64", vrs, nvr, vals, nv) == OK and inst.get("formulation") == 1
+    n = len(inst.messages)
+    assert inst.set(Omega=700.0) == ERROR and "accepted range [0, 640.8]" in inst.logged(n)
+    assert inst.get("message") == inst.logged(n)  # the cause is in the 'message' output too
+    assert inst.call("fmi3ExitInitializationMode") <= WARNING
+
+
+# ------------------------------------------------------------------------------------------ the product
+ARCH3 = {"x86_64-linux": "x86_64", "aarch64-linux": "aarch64", "x86_64-windows": "x86_64",
+         "x86_64-darwin": "x86_64", "aarch64-darwin": "aarch64"}
+
+
+def test_every_platform_of_the_fmi2_fmu_in_fmi3_folders(tmp_path):
+    """The FMI 2.0 native FMU's platforms and baseline: each binary, in its FMI 3.0 folder, exports the whole FMI
+    3.0 API for its architecture and nothing of the kernel; the Linux ones need glibc 2.17 and no libm."""
+    pytest.importorskip("ziglang", reason="cross-compiling the FMU needs ziglang (a dependency of rotorub)")
+    from fmu_src.build.binaries import elf_version_needs, exported_symbols, missing_fmi_functions, newest_glibc
+    from fmu_src.build.native_fmu3 import build_native_fmu3
+
+    out = build_native_fmu3(tmp_path / "all")
+    assert set(out["platforms"]) == {"linux64", "aarch64-linux", "win64", "darwin64", "aarch64-darwin"}
+    with zipfile.ZipFile(out["fmu"]) as z:
+        z.extractall(tmp_path / "unz")
+    for folder, arch in ARCH3.items():
+        [binary] = list((tmp_path / "unz" / "binaries" / folder).iterdir())
+        [(got, names)] = exported_symbols(binary)
+        assert got == arch and missing_fmi_functions(binary, "3.0") == {arch: []}, folder
+        assert not [n for n in names if n.startswith(("rr_", "core_", "model_"))], folder
+        if folder.endswith("linux"):
+            assert set(elf_version_needs(binary)) == {"libc.so.6"} and newest_glibc(binary) <= (2, 17), folder
+
+
+def test_rebuilt_with_the_fmus_own_cmakelists_gives_the_same_numbers(fmu3, tmp_path):
+    import shutil
+    import subprocess
+    import sys
+
+    cmake = shutil.which("cmake") or str(Path(sys.executable).parent / "cmake")
+    if not Path(cmake).exists() and not shutil.which(cmake):
+        pytest.skip("no cmake")
+    d, ref = tmp_path / "fmu", tmp_path / "ref"
+    for x in (d, ref):
+        with zipfile.ZipFile(fmu3) as z:
+            z.extractall(x)
+    build = tmp_path / "build"
+    for args in (["-S", str(d / "sources"), "-B", str(build), "-DCMAKE_BUILD_TYPE=Release"],
+                 ["--build", str(build), "--config", "Release"]):
+        r = subprocess.run([cmake, *args], capture_output=True, text=True)
+        assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    shutil.copy2(build / "RotorCasingContact.so", d / "binaries" / "x86_64-linux" / "RotorCasingContact.so")
+
+    def run(folder: Path) -> np.ndarray:
+        with Slave3(None, unzipped=str(folder), early_return=True) as s:
+            assert s.init(**START) == OK
+            rows = []
+            for _ in range(300):
+                assert s.step(1e-3)[0] == OK
+                rows.append(s.get("blade.F_N"))
+        return np.array(rows)
+
+    a, b = run(ref), run(d)
+    assert a.max() > 10.0 and np.array_equal(a, b)
