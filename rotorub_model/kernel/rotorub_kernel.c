@@ -716,6 +716,10 @@ int rr_cd_run(rr_cd_job *job)
     const double omega = job->omega;
     const long long step0 = s->steps;
     rr_surface *sf = c->surface;
+    /* the job's options in locals: read once, not after every store into the records (they may alias) */
+    const int stop_on_contact = job->stop_on_contact, rec_cap = job->rec_cap;
+    const int rec_wear_every = job->rec_wear_every < 1 ? 1 : job->rec_wear_every;
+    double *const rec_wear = sf ? job->rec_wear : NULL, *const rec_q = job->rec_q, *const rec_out = job->rec_out;
     int open = 1;
     job->done = 0;
     if (s->diverged) return 0;
@@ -751,10 +755,9 @@ int rr_cd_run(rr_cd_job *job)
         }
         laws_of(c, gaps, law);
         friction_of(c, law, omega, NULL, q, qp, dt, fr);
-        if (sf && job->rec_wear && (step0 + i + 1) % (job->rec_wear_every < 1 ? 1 : job->rec_wear_every) == 0 &&
-            job->n_rec_wear < job->rec_wear_cap) {
+        if (rec_wear && (step0 + i + 1) % rec_wear_every == 0 && job->n_rec_wear < job->rec_wear_cap) {
             int m, p, ns = sf->n_sectors, np = c->np;
-            double *dst = job->rec_wear + (size_t)job->n_rec_wear * ns;
+            double *dst = rec_wear + (size_t)job->n_rec_wear * ns;
             for (m = 0; m < ns; ++m) {
                 double w = 0.0;
                 for (p = 0; p < np; ++p) w += sf->depth[(size_t)p * ns + m];
@@ -762,13 +765,12 @@ int rr_cd_run(rr_cd_job *job)
             }
             ++job->n_rec_wear;
         }
-        if ((step0 + i + 1) % rec_every == 0 && written < job->rec_cap) {
-            for (k = 0; k < n; ++k) job->rec_q[(size_t)written * n + k] = q[k];
-            if (job->rec_out)
-                outputs_from_law(c, q, gaps, law, fr, 0.0, NULL, job->rec_out + (size_t)written * RR_N_OUT(nb));
+        if ((step0 + i + 1) % rec_every == 0 && written < rec_cap) {
+            for (k = 0; k < n; ++k) rec_q[(size_t)written * n + k] = q[k];
+            if (rec_out) outputs_from_law(c, q, gaps, law, fr, 0.0, NULL, rec_out + (size_t)written * RR_N_OUT(nb));
             ++written;
         }
-        if (job->stop_on_contact) {
+        if (stop_on_contact) {
             int was_open = open;
             open = 1;
             for (k = 0; k < rows; ++k)
