@@ -47,6 +47,9 @@ struct model_runtime {
     rr_surface surf;
     double *surf_mem;
     double cell_area; /* m^2: arc at the tip radius times the band the tips sweep (chord cos stagger) */
+    double wear[RR_WEAR_OUT]; /* the liner's summary, recomputed only when a cell was cut (720 cells x 8 harmonics
+                               * every step would cost more than the step) */
+    int have_wear;
 };
 
 static void *zalloc(size_t n, size_t size) { return calloc(n ? n : 1, size); }
@@ -263,7 +266,7 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
             model_free(m);
             return NULL;
         }
-        if (m->mode == MODE_TRANSIENT) m->contact.surface = &m->surf;
+        /* the surface is seen by the steps from the first one that needs it (transient_step) */
     }
     return m;
 oom:
@@ -319,12 +322,16 @@ static int substeps(model_runtime *m, double w, double h, char *msg, size_t len)
 }
 
 /* the liner's summary and the clearance the engine keeps, into the outputs */
-static void wear_outputs(const model_runtime *m, model_values *v)
+static void wear_outputs(model_runtime *m, model_values *v)
 {
-    double out[RR_WEAR_OUT];
+    const double *out = m->wear;
     int k;
     double closure = v->r[VR_CLOSURE];
-    rr_surface_summary(&m->contact, &m->surf, m->cell_area, out);
+    if (!m->have_wear || m->surf.changed) {
+        rr_surface_summary(&m->contact, &m->surf, m->cell_area, m->wear);
+        m->surf.changed = 0;
+        m->have_wear = 1;
+    }
     for (k = 0; k < RR_WEAR_OUT; ++k) {
         if (k == RR_WEAR_LOBES)
             v->i[WEAR_INDEX[k]] = (int)out[k];
@@ -373,6 +380,13 @@ static model_status transient_step(model_runtime *m, model_values *v, double w, 
     m->surf.closure = v->r[VR_CLOSURE];
     m->surf.offset_x = v->r[VR_OFFSET_X];
     m->surf.offset_y = v->r[VR_OFFSET_Y];
+    /* a rigid liner with the engine's inputs at zero adds exactly 0 to every gap: the kernel then runs without
+     * the surface (the paper's loop, none of its cost); attached again as soon as anything is nonzero. Once
+     * worn, the liner stays attached (its depths are nonzero) */
+    m->contact.surface = m->surf.wears || m->surf.closure != 0.0 || m->surf.offset_x != 0.0 ||
+                                 m->surf.offset_y != 0.0
+                             ? &m->surf
+                             : NULL;
     m->job.n_steps = ns;
     m->job.omega = w;
     m->job.me = me;
@@ -593,6 +607,7 @@ int model_state_restore(model_runtime *m, const double *in, size_t count)
     }
     m->surf.phi = in[12];
     m->surf.plastic_work = in[13];
+    m->have_wear = 0; /* another profile: its summary is computed anew */
     for (k = 0; k < cells; ++k) m->surf.depth[k] = in[STATE_HEAD + 3 * (size_t)n + k];
     m->have_mats = 0; /* dt may differ */
     return 0;

@@ -479,7 +479,14 @@ class RotorCasingContact(Fmi2Slave):
                          f"the central-difference matrix is singular at {omega:g} rad/s, dt = {h / n:g} s")
             return False
         rv, iv = self._rv, self._iv
-        self._sim["liner"].set_inputs(float(rv[self._i_closure]), (float(rv[self._i_offx]), float(rv[self._i_offy])))
+        liner = self._sim["liner"]
+        closure, offset = float(rv[self._i_closure]), (float(rv[self._i_offx]), float(rv[self._i_offy]))
+        if closure != liner.closure or offset != liner.offset:  # ctypes writes only when the engine moved
+            liner.set_inputs(closure, offset)
+        # as the native FMU: the surface only when it adds something (worn or wearing, closure or offset)
+        on = liner.wears or closure != 0.0 or offset != (0.0, 0.0)
+        if on != cd.liner_on:
+            cd.use_liner(on)
         done, _ = cd.advance(n, omega, me)  # the kernel writes the outputs into self._rv (bind_outputs)
         self._write_wear()
         iv[self._i_nc] = rv[self._i_nc]
@@ -493,13 +500,17 @@ class RotorCasingContact(Fmi2Slave):
         iv[self._i_status] = self._if.STATUS_OK
         return True
 
-    def _write_wear(self) -> None:
-        """The liner's summary (the kernel's) and the clearance the engine keeps, into the outputs."""
+    def _write_wear(self, fresh: bool = False) -> None:
+        """The liner's summary (the kernel's; recomputed only when a cell was cut, as the native FMU does) and the
+        clearance the engine keeps, into the outputs."""
         liner, out = self._sim["liner"], self._wear_out
-        liner.summary_into(out)
-        self._rv[self._wear_index] = out
-        self._iv[self._i_lobes] = int(out[4])
-        self._rv[self._i_clear] = self._sim["g0"] - float(self._rv[self._i_closure]) + out[1]
+        if fresh or liner.struct.changed or not self._sim.get("wear_valid"):
+            liner.summary_into(out)
+            liner.struct.changed = 0
+            self._sim["wear_valid"] = True
+            self._rv[self._wear_index] = out  # else the outputs hold these values already
+            self._iv[self._i_lobes] = int(out[4])
+        self._rv[self._i_clear] = self._sim["g0"] - self._rv[self._i_closure] + out[1]
 
     def _quasi_static(self, omega: float, me: float, h: float) -> tuple[bool, str]:
         sim, lib = self._sim, self._lib
@@ -648,7 +659,7 @@ class RotorCasingContact(Fmi2Slave):
                                  np.asarray(c["q_prev"], dtype=float), c["diverged"], c["dt"], c["g0"],
                                  (np.asarray(ls["depth"], dtype=float), float(ls["phi"]), float(ls["plastic_work"]),
                                   liner.closure, liner.offset)))
-            self._write_wear()
+            self._write_wear(fresh=True)
         if s["g0"] != sim["g0"]:
             sim["g0"] = s["g0"]
             self._apply_clearance(s["g0"])

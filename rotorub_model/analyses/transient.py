@@ -123,7 +123,20 @@ class CentralDifference:
         else:  # the loop's own view of the contact, with the liner's surface (the model's own stays rigid)
             self.liner.contact = c
             self._seen = self.liner.attach(c.kernel)
-            self._job.contact = ctypes.addressof(self._seen)
+            self.use_liner(self._liner_on)
+
+    _liner_on = True  # whether the loop sees the liner (use_liner)
+
+    @property
+    def liner_on(self) -> bool:
+        return self._liner_on
+
+    def use_liner(self, on: bool) -> None:
+        """Let the loop see the liner or not. A rigid liner with no closure and no offset adds exactly 0 to every
+        gap: without it the kernel runs the paper's loop (none of the surface's cost), with the same numbers."""
+        self._liner_on = bool(on)
+        if self.liner is not None:
+            self._job.contact = ctypes.addressof(self._seen if on else self._contact.kernel)
 
     @staticmethod
     def _check_dt(dt: float | None, limit: float) -> float:
