@@ -201,8 +201,8 @@ def test_a_vibration_locked_to_engine_order_h_leaves_h_lobes(model, h):
     amps = [sm[f"harmonic_{k}"] for k in range(1, 9)]
     assert sm["lobes"] == h, amps
     # a pattern of h-fold symmetry holds only multiples of h; the run's drift (the contact detunes the
-    # vibration) leaves the others at most half of a_h (measured: 0 for h = 2, 0.02 a_h for h = 3)
-    assert amps[h - 1] > 1.5 * max(a for k, a in enumerate(amps, 1) if k % h)
+    # vibration) leaves the others small (measured: 0 for h = 2, 0.02 a_h for h = 3)
+    assert amps[h - 1] > 10 * max(a for k, a in enumerate(amps, 1) if k % h)
 
 
 def test_a_wearing_run_creates_no_energy(undamped):
