@@ -464,3 +464,42 @@ def test_rebuilt_with_the_fmus_own_cmakelists_gives_the_same_numbers(fmu3, tmp_p
 
     a, b = run(ref), run(d)
     assert a.max() > 10.0 and np.array_equal(a, b)
+
+
+# ------------------------------------------------------------------------------------------ found in fmusim 0.0.39
+_STATE_BY_VALUE = """
+import ctypes, sys
+from fmu_src.harness.fmi3_run import Slave3
+i = Slave3(None, unzipped=sys.argv[1])
+assert i.init(g0=0.2e-3, Omega=176.2, imbalance=0.022) == 0 and i.step()[0] == 0
+state = i.f.getFMUState()
+free = ctypes.CDLL(i.f.dll._name).fmi3FreeFMUState  # without fmpy's argtypes: the state itself goes in
+free.restype = ctypes.c_int
+print("status", free(ctypes.c_void_p(i.f.component), state))
+print("step", i.step()[0])
+print("log", " | ".join(m for s, m in i.messages if s >= 1))
+i.free()
+"""
+
+
+def test_a_state_freed_by_value_is_freed_with_a_warning_not_a_crash(unzipped3):
+    """fmusim 0.0.39 hands fmi3FreeFMUState the state itself, not the address of the variable holding it (a crash
+    of the host before): freed, with a warning, and the instance goes on. In a process of its own."""
+    import subprocess
+    import sys
+
+    r = subprocess.run([sys.executable, "-c", _STATE_BY_VALUE, str(unzipped3)], capture_output=True, text=True,
+                       timeout=60, cwd=str(Path(__file__).resolve().parents[1]))
+    assert r.returncode == 0, r.stderr[-2000:]
+    out = dict(line.split(" ", 1) for line in r.stdout.splitlines())
+    assert out["status"] == str(WARNING) and out["step"] == str(OK)
+    assert "instead of a pointer to it" in out["log"]
+
+
+def test_outputs_are_readable_in_initialization_mode(inst):
+    """The initial state's outputs in initialization mode, following the values set so far (FMI 3.0 allows
+    reading them there; they read 0 before)."""
+    assert inst.call("fmi3EnterInitializationMode", False, 0.0, 0.0, False, 0.0) == OK
+    assert inst.set(g0=0.7e-3) == OK
+    assert inst.get("gap_min") == 0.7e-3 and np.all(inst.get("blade.gap_tip") == 0.7e-3)
+    assert inst.call("fmi3ExitInitializationMode") == OK

@@ -308,9 +308,11 @@ static int substeps(model_runtime *m, double w, double h, char *msg, size_t len)
     {
         double nd = rr_ceil(h / cap * (1.0 - 1e-9));
         if (!(nd <= MODEL_MAX_SUBSTEPS)) {
-            snprintf(msg, len, "communication step h = %.17g s needs %.3g substeps of at most %.17g s (dt_max, or half "
-                     "the central-difference limit at %g rad/s); at most %d are taken in one step (h <= %.17g s)",
-                     h, nd, cap, band, MODEL_MAX_SUBSTEPS, MODEL_MAX_SUBSTEPS * cap);
+            char bh[32], bc[32], bt[32];
+            snprintf(msg, len, "communication step h = %s s needs %.3g substeps of at most %s s (dt_max, or half the "
+                     "central-difference limit at %g rad/s); at most %d are taken in one step (h <= %s s)",
+                     core_num(h, bh, sizeof bh), nd, core_num(cap, bc, sizeof bc), band, MODEL_MAX_SUBSTEPS,
+                     core_num(MODEL_MAX_SUBSTEPS * cap, bt, sizeof bt));
             return -1;
         }
         m->plan_n = nd < 1.0 ? 1 : (int)nd;
@@ -349,7 +351,7 @@ static model_status transient_step(model_runtime *m, model_values *v, double w, 
     double dt;
     size_t k, nn = (size_t)n * n;
     if (m->st.diverged) {
-        snprintf(msg, len, "the run diverged at t = %.6g s (internal time)", m->st.t);
+        snprintf(msg, len, "the run diverged in an earlier step");
         return MODEL_DISCARD;
     }
     ns = substeps(m, w, h, msg, len);
@@ -405,9 +407,9 @@ static model_status transient_step(model_runtime *m, model_values *v, double w, 
     *event = done < ns && !m->st.diverged; /* only stop_on_contact ends a run early without a divergence */
     if (*event) return MODEL_OK;
     if (done < ns || m->st.diverged) {
-        snprintf(msg, len, "the run diverged at t = %.6g s (internal time): a blade penetrated the casing deeper "
-                 "than max_penetration = %g mm (or the state stopped being finite); the outputs are those of that "
-                 "state", m->st.t, m->max_pen * 1e3);
+        /* the time it reached is the wrapper's to say: the last successful time, the one a master reads */
+        snprintf(msg, len, "the run diverged: a blade penetrated the casing deeper than max_penetration = %g mm (or "
+                 "the state stopped being finite); the outputs are those of that state", m->max_pen * 1e3);
         return MODEL_DISCARD;
     }
     return MODEL_OK;

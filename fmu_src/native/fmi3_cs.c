@@ -859,7 +859,10 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
     *earlyReturn = early ? fmi3True : fmi3False;
     *terminateSimulation = c->core.stopped ? fmi3True : fmi3False;
     *lastSuccessfulTime = c->core.last_good;
-    if (early) core_debug(&c->core, "fmi3DoStep: first contact at t = %.17g s: early return", c->core.time);
+    if (early) {
+        char bt[32];
+        core_debug(&c->core, "fmi3DoStep: first contact at t = %s s: early return", core_num(c->core.time, bt, sizeof bt));
+    }
     return s;
 }
 

@@ -27,6 +27,7 @@
 const char *const CORE_PHASE_NAME[] = {"instantiated", "initialization mode", "step mode", "terminated"};
 
 typedef struct {
+    void *self;             /* the snapshot's own address: tells a state passed by value from a pointer to one */
     unsigned magic;
     const model_info *info; /* &MODEL_INFO of the binary that made it: another FMU's (or build's) is refused */
     const fmu_core *owner;
@@ -71,7 +72,8 @@ static void logv(fmu_core *c, model_status status, const char *category, const c
 model_status core_fail(fmu_core *c, model_status status, const char *fmt, ...)
 {
     va_list ap;
-    if (status == MODEL_ERROR) c->i[MODEL_INFO.vr_status] = STATUS_BAD_INPUT;
+    /* a refusal after a divergence leaves status at 1: the run ended diverged, whatever the master tries next */
+    if (status == MODEL_ERROR && !c->stopped) c->i[MODEL_INFO.vr_status] = STATUS_BAD_INPUT;
     va_start(ap, fmt);
     logv(c, status, status == MODEL_ERROR ? "logStatusError" : "logStatusDiscard", fmt, ap);
     va_end(ap);
@@ -200,14 +202,35 @@ void core_store_real(fmu_core *c, int slot, double x)
 {
     if (c->r[slot] != x) after_set(c, slot);
     c->r[slot] = x;
+    c->initial_stale = 1;
 }
 
-void core_store_int(fmu_core *c, int slot, int x) { c->i[slot] = x; }
+void core_store_int(fmu_core *c, int slot, int x)
+{
+    c->i[slot] = x;
+    c->initial_stale = 1;
+}
+
+/* FMI lets a master read the outputs in initialization mode, and masters that propagate their connections
+ * before the first step (libcosim, OMSimulator) pass them on: they are those of a model configured from the
+ * values set so far, redone after any value changes. A configuration that does not hold yet is no error
+ * here (the master may still be setting values): exit from initialization mode reports it. */
+static model_status initial_outputs(fmu_core *c)
+{
+    char msg[CORE_MSG_LEN];
+    if (!c->initial_stale && c->m) return MODEL_OK;
+    c->initial_stale = 0;
+    model_free(c->m);
+    c->m = model_configure(&c->v, c->time, msg, sizeof msg);
+    if (c->m) (void)model_solve_now(c->m, &c->v, c->time, msg, sizeof msg);
+    return MODEL_OK;
+}
 
 model_status core_refresh_outputs(fmu_core *c)
 {
     char msg[CORE_MSG_LEN];
     model_status s;
+    if (c->phase == PH_INITIALIZATION) return initial_outputs(c);
     if (!MODEL_INFO.feedthrough || !c->inputs_changed || !c->m || c->phase != PH_STEP) return MODEL_OK;
     c->inputs_changed = 0;
     s = model_solve_now(c->m, &c->v, c->time, msg, sizeof msg);
@@ -225,6 +248,7 @@ model_status core_enter_init(fmu_core *c, const char *fn)
     if (c->phase != PH_INSTANTIATED)
         return core_fail(c, MODEL_ERROR, "%s: the instance is in %s", fn, CORE_PHASE_NAME[c->phase]);
     c->phase = PH_INITIALIZATION;
+    c->initial_stale = 1;
     return MODEL_OK;
 }
 
@@ -335,24 +359,33 @@ static void free_snapshot(snapshot_t *p)
     free(p);
 }
 
+/* a snapshot with room for every variable (and n_model model values), marked as this binary's */
+static snapshot_t *new_snapshot(fmu_core *c, size_t n_model)
+{
+    snapshot_t *p = (snapshot_t *)calloc(1, sizeof *p);
+    if (!p) return NULL;
+    p->r = (double *)calloc(CORE_N_VARS, sizeof(double));
+    p->i = (int *)calloc(CORE_N_VARS, sizeof(int));
+    p->model = n_model ? (double *)calloc(n_model, sizeof(double)) : NULL;
+    if (!p->r || !p->i || (n_model && !p->model)) {
+        free_snapshot(p);
+        return NULL;
+    }
+    p->self = p;
+    p->magic = c->d->state_magic;
+    p->info = &MODEL_INFO;
+    p->owner = c;
+    p->n_model = n_model;
+    return p;
+}
+
 model_status core_get_state(fmu_core *c, const char *fn, void **state)
 {
     snapshot_t *p;
     if (!state) return core_fail(c, MODEL_ERROR, "%s: NULL pointer", fn);
     p = (snapshot_t *)*state;
     if (p && !IS_OURS(c, p)) return core_fail(c, MODEL_ERROR, "%s: *FMUstate is not a state of this FMU", fn);
-    if (!p) {
-        p = (snapshot_t *)calloc(1, sizeof *p);
-        if (!p) return core_fail(c, MODEL_ERROR, "%s: out of memory", fn);
-        p->r = (double *)calloc(CORE_N_VARS, sizeof(double));
-        p->i = (int *)calloc(CORE_N_VARS, sizeof(int));
-        if (!p->r || !p->i) {
-            free_snapshot(p);
-            return core_fail(c, MODEL_ERROR, "%s: out of memory", fn);
-        }
-    }
-    p->magic = c->d->state_magic;
-    p->info = &MODEL_INFO;
+    if (!p && !(p = new_snapshot(c, 0))) return core_fail(c, MODEL_ERROR, "%s: out of memory", fn);
     p->owner = c;
     p->phase = c->phase;
     p->time = c->time;
@@ -435,12 +468,23 @@ model_status core_set_state(fmu_core *c, const char *fn, const void *state)
     c->stopped = p->stopped;
     memcpy(c->stop_reason, p->stop_reason, CORE_MSG_LEN);
     c->inputs_changed = 0;
+    c->initial_stale = 1;
     return MODEL_OK;
 }
 
 model_status core_free_state(fmu_core *c, const char *fn, void **state)
 {
     if (!state || !*state) return MODEL_OK;
+    if (*state == (void *)state) {
+        /* the state itself where the standard passes the address of the host's variable holding it (fmusim
+         * 0.0.39 does this): its first field is its own address. Freed, so the host neither crashes nor leaks;
+         * the host's variable cannot be cleared, hence the warning. */
+        if (!IS_OURS(c, (snapshot_t *)state)) return core_fail(c, MODEL_ERROR, "%s: not a state of this FMU", fn);
+        free_snapshot((snapshot_t *)state);
+        core_warn(c, "%s: was given the FMU state itself instead of a pointer to it (a defect of the host); the state "
+                  "is freed, but the host's variable still holds its address: do not use it", fn);
+        return MODEL_WARNING;
+    }
     if (!IS_OURS(c, (snapshot_t *)*state)) return core_fail(c, MODEL_ERROR, "%s: not a state of this FMU", fn);
     free_snapshot((snapshot_t *)*state);
     *state = NULL;
@@ -521,20 +565,8 @@ model_status core_deserialize(fmu_core *c, const char *fn, const unsigned char *
     if (phase > PH_TERMINATED || nv != CORE_N_VARS || nm > 100000 || stopped > 1 ||
         size != serialized_size_of((size_t)nm))
         return core_fail(c, MODEL_ERROR, "%s: corrupt state (sizes do not match this FMU)", fn);
-    p = (snapshot_t *)calloc(1, sizeof *p);
-    if (!p) return core_fail(c, MODEL_ERROR, "%s: out of memory", fn);
-    p->r = (double *)calloc(CORE_N_VARS, sizeof(double));
-    p->i = (int *)calloc(CORE_N_VARS, sizeof(int));
-    p->model = nm ? (double *)calloc((size_t)nm, sizeof(double)) : NULL;
-    if (!p->r || !p->i || (nm && !p->model)) {
-        free_snapshot(p);
-        return core_fail(c, MODEL_ERROR, "%s: out of memory", fn);
-    }
-    p->magic = c->d->state_magic;
-    p->info = &MODEL_INFO;
-    p->owner = c;
+    if (!(p = new_snapshot(c, (size_t)nm))) return core_fail(c, MODEL_ERROR, "%s: out of memory", fn);
     p->phase = (core_phase)phase;
-    p->n_model = (size_t)nm;
     p->stopped = (int)stopped;
     GET(&p->time, 8);
     GET(&p->last_good, 8);

@@ -54,13 +54,11 @@ struct fmu_core {
     model_values v;
     model_runtime *m;
     int inputs_changed; /* feedthrough: outputs to recompute before a read */
+    int initial_stale;  /* initialization mode: a value changed since the outputs were last computed */
 };
 
 #define CORE_N_VARS ((size_t)MODEL_INFO.n_vars)
 #define CORE_VAR(slot) (&MODEL_INFO.vars[slot])
-
-/* the shortest decimal that reads back as x (%.17g writes 640.8 as 640.79999999999995) */
-const char *core_num(double x, char *buf, size_t len);
 
 /* 0, or -1 (out of memory: nothing allocated); the values start at their start values */
 int core_init(fmu_core *c, const core_dialect *d, core_log_fn log, const char *name, int logging);

@@ -102,4 +102,9 @@ int model_state_restore(model_runtime *m, const double *in, size_t n);
  * model_step's. */
 model_status model_step_to_event(model_runtime *m, model_values *v, double t, double h, int *event, char *msg,
                                  size_t len);
+
+/* ------------------------------------------------------------------ what the wrapper offers a model */
+/* the shortest decimal that reads back as x (%.17g writes 640.8 as 640.79999999999995): every number a message
+ * gives a master to act on (a step, a limit) reads back as the double the FMU used (fmu_core.c) */
+const char *core_num(double x, char *buf, size_t len);
 #endif

@@ -106,9 +106,11 @@ model_status model_step(model_runtime *m, model_values *v, double t, double h, c
     int n, i;
     m->advanced = 0.0;
     if (!(nd <= MODEL_MAX_SUBSTEPS)) {
-        snprintf(msg, len, "communication step h = %.17g s needs %.3g substeps of at most dt_max = %.17g s; at most "
-                 "%d are taken in one step (h <= %.17g s); step refused, state unchanged", h, nd, m->dt_max,
-                 MODEL_MAX_SUBSTEPS, MODEL_MAX_SUBSTEPS * m->dt_max);
+        char bh[32], bd[32], bt[32];
+        snprintf(msg, len, "communication step h = %s s needs %.3g substeps of at most dt_max = %s s; at most %d are "
+                 "taken in one step (h <= %s s); step refused, state unchanged", core_num(h, bh, sizeof bh), nd,
+                 core_num(m->dt_max, bd, sizeof bd), MODEL_MAX_SUBSTEPS,
+                 core_num(MODEL_MAX_SUBSTEPS * m->dt_max, bt, sizeof bt));
         return MODEL_ERROR;
     }
     n = nd < 1.0 ? 1 : (int)nd;
