@@ -311,13 +311,18 @@ def model_description(vars_: list[Var], *, guid: str, generation_tool: str, vers
                       author: str = "rotorub developers", model_name: str = MODEL_NAME,
                       model_identifier: str = MODEL_IDENTIFIER, description: str = DESCRIPTION,
                       units: dict | None = None, enumerations: dict | None = None,
-                      default_experiment: dict | None = None) -> Element:
+                      default_experiment: dict | None = None, initial_from_parameters: bool = False) -> Element:
     """The FMI 2.0 co-simulation model description of ``vars_`` (an ElementTree element); the contact
     FMU's by default, any other model's (the LP spool) with its names, units and experiment.
 
     ``feedthrough``: the outputs depend directly on the inputs (the quasi_static build: its
     outputs are the algebraic solution at the current inputs); otherwise they depend on no
     input (the transient build: outputs follow the state, no algebraic loop with the spool).
+
+    ``initial_from_parameters``: the initial outputs depend on the parameters alone, not on the inputs (the
+    spool's initial speed is its Omega0 whatever torque it is given): declared, so that a master that
+    propagates initial values (OMSimulator) sees no algebraic loop at initialisation. Otherwise an initial
+    output declares no dependencies: it may depend on everything, as FMI 2.0 reads that.
     """
     units = UNITS if units is None else units
     enumerations = ENUMERATIONS if enumerations is None else enumerations
@@ -398,9 +403,13 @@ def model_description(vars_: list[Var], *, guid: str, generation_tool: str, vers
                 attrs["dependenciesKind"] = " ".join("dependent" for _ in inputs)
             SubElement(outs, "Unknown", attrs)
     init = SubElement(ms, "InitialUnknowns")
+    params = " ".join(str(i + 1) for i, v in enumerate(vars_) if v.causality == "parameter")
     for i, v in enumerate(vars_):
         if v.causality == "output":
-            SubElement(init, "Unknown", index=str(i + 1))
+            attrs = {"index": str(i + 1)}
+            if initial_from_parameters:
+                attrs["dependencies"] = params
+            SubElement(init, "Unknown", attrs)
     return root
 
 

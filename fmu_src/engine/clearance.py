@@ -8,7 +8,7 @@ import math
 from pathlib import Path
 
 from . import clearance_interface as ci
-from .system import EngineError
+from .system import EngineError, specs_variables
 
 NATIVE_SOURCES = ("fmi2_cs.c", "fmu_core.c", "clearance_model.c", "model_data.c")
 C_ORDER = ("Omega", "closure0", "c_centrifugal", "c_thermal", "tau_thermal", "closure", "closure_centrifugal",
@@ -17,17 +17,7 @@ C_ORDER = ("Omega", "closure0", "c_centrifugal", "c_thermal", "tau_thermal", "cl
 
 def clearance_variables(values: dict | None = None):
     """clearance_interface.SPECS as interface.Var (value reference = position)."""
-    from ..interface import Var
-
-    values = {**ci.DEFAULTS, **(values or {})}
-    out = []
-    for k, (name, typ, causality, variability, unit, rng, desc) in enumerate(ci.SPECS):
-        start = values.get(name, 0.0) if causality != "output" else None
-        nominal = (abs(start) or 1.0) if typ == "Real" and causality != "output" else None
-        out.append(Var(name, typ, causality, variability, desc, unit=unit, start=start,
-                       min=None if rng is None else rng[0], max=None if rng is None else rng[1], nominal=nominal,
-                       vr=k))
-    return out
+    return specs_variables(ci.SPECS, {**ci.DEFAULTS, **(values or {})})
 
 
 def build_clearance_fmu(dest: str | Path = "fmus/native", platforms: tuple[str, ...] | None = None,

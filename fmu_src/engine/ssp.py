@@ -523,10 +523,17 @@ def run_ssp_fmpy(ssp: str | Path, t_end: float, h: float | None = None,
                 f.enterInitializationMode()
                 for flag, vr, v in c["values"]:
                     (f.setReal if flag == "p" else f.setInteger)([vr], [v])
-                f.exitInitializationMode()
             by = {c["name"]: c for c in m["components"]}
             links = [(slaves[se].fmu, by[se]["vr"][sc], slaves[ee].fmu, by[ee]["vr"][ec])
                      for se, sc, ee, ec in m["connections"]]
+            # the connections' initial values, as libcosim, OMSimulator and run_ssp_native propagate them: one
+            # Jacobi pass per component carries a value down any chain
+            for _ in slaves:
+                values = [src.getReal([vr])[0] for src, vr, _d, _v in links]
+                for (_s, _vr, dst, dvr), v in zip(links, values):
+                    dst.setReal([dvr], [v])
+            for s in slaves.values():
+                s.fmu.exitInitializationMode()
             for comp, var in record:
                 if comp not in by or var not in by[comp]["vr"]:
                     raise EngineError(f"run_ssp_fmpy: no variable {comp}.{var} in {ssp}")

@@ -42,6 +42,25 @@ class FmuVariable:
     declared_type: str | None = None  # an Enumeration's type name (its items: enumerations(root))
 
 
+def specs_variables(specs, values: dict):
+    """A small engine FMU's SPECS ((name, type, causality, variability, unit, (min, max) or None, description), in
+    value-reference order) as interface.Var, with ``values`` as the start values. The nominal value is the start's
+    magnitude, or, for a start of 0, 1 in the unit unless the range is smaller (a closure0 of range +-10 mm is
+    nominal 10 mm, not 1 m)."""
+    from ..interface import Var
+
+    out = []
+    for k, (name, typ, causality, variability, unit, rng, desc) in enumerate(specs):
+        start = values.get(name, 0.0) if causality != "output" else None
+        nominal = None
+        if typ == "Real" and causality != "output":
+            nominal = abs(start) or min(1.0, max(abs(rng[0]), abs(rng[1])) if rng else 1.0) or 1.0
+        out.append(Var(name, typ, causality, variability, desc, unit=unit, start=start,
+                       min=None if rng is None else rng[0], max=None if rng is None else rng[1], nominal=nominal,
+                       vr=k))
+    return out
+
+
 def read_description(source) -> tuple[dict[str, FmuVariable], dict[str, dict[str, float]], ET.Element]:
     """(variables by name, unit name -> base-unit exponents, root) of an FMU file, FMU bytes or folder."""
     if isinstance(source, bytes | bytearray):

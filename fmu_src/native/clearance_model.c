@@ -8,9 +8,9 @@
  * the centrifugal growth of disk and blades at once, the thermal growth with the lag of the casing's
  * temperature. With Omega held over a step the lag is integrated exactly (an exponential), so the model has
  * no step-size error to speak of. The outputs follow the speed held over the last step; before the first,
- * the declared start value of Omega (the engine's speed before the run, warm there): what an input holds at
- * initialisation depends on the master (libcosim propagates its connections' initial values, fmpy does
- * not), the declared start does not.
+ * the speed Omega holds when initialisation ends (the engine's speed before the run, warm there): the spool's
+ * initial speed where the master propagates its connections' initial values (libcosim, OMSimulator and the
+ * project's fmpy and C masters do), else the declared start value.
  */
 #include <math.h>
 #include <stdio.h>
@@ -50,8 +50,8 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
     m->ct = v->r[VR_CT];
     m->tau = v->r[VR_TAU];
     m->t = t0;
-    m->w = MODEL_INFO.vars[VR_OMEGA].start;
-    m->d = m->ct * m->w * m->w; /* warm at the start speed: the engine ran there */
+    m->w = v->r[VR_OMEGA];
+    m->d = m->ct * m->w * m->w; /* warm at the initial speed: the engine ran there */
     return m;
 }
 

@@ -46,6 +46,17 @@ typedef struct { int fmu; fmi2ValueReference vr; } Column;
 static Fmu fmus[MAX_FMUS];
 static int n_fmus;
 
+/* Jacobi exchange: every connected input from its source's output, all outputs read first */
+static fmi2Status exchange(Link *links, size_t nl, fmi2Status st)
+{
+    size_t i;
+    for (i = 0; i < nl; i++)
+        st = worst(st, fmus[links[i].from].lib.GetReal(fmus[links[i].from].c, &links[i].from_vr, 1, &links[i].value));
+    for (i = 0; i < nl && st <= fmi2Warning; i++)
+        st = worst(st, fmus[links[i].to].lib.SetReal(fmus[links[i].to].c, &links[i].to_vr, 1, &links[i].value));
+    return st;
+}
+
 static void usage(const char *msg)
 {
     fprintf(stderr, "engine_host: %s\nusage: engine_host -n STEPS -s STEP [-t START] [-q] -F NAME=DIR:MODEL... "
@@ -208,6 +219,9 @@ int main(int argc, char **argv)
     for (i = 0; i < nis; i++)
         st = worst(st, fmus[is[i].fmu].lib.SetInteger(fmus[is[i].fmu].c, &is[i].vr, 1, &is[i].value));
     for (k = 0; k < n_fmus; k++) st = worst(st, fmus[k].lib.EnterInitializationMode(fmus[k].c));
+    /* the connections' initial values, as libcosim and OMSimulator propagate them: one pass per FMU carries a
+     * value down any chain of connections (a loop needs an FMU whose initial outputs do not read its inputs) */
+    for (k = 0; k < n_fmus && st <= fmi2Warning; k++) st = exchange(links, nl, st);
     for (k = 0; k < n_fmus; k++) st = worst(st, fmus[k].lib.ExitInitializationMode(fmus[k].c));
     if (st > fmi2Warning) {
         fprintf(stderr, "engine_host: initialisation returned %s\n", status_name(st));
@@ -222,11 +236,7 @@ int main(int argc, char **argv)
     t = t0;
     for (step = 0;; step++) {
         /* Jacobi exchange at t: every input from the outputs at t, then the row */
-        for (i = 0; i < nl; i++)
-            st = worst(st, fmus[links[i].from].lib.GetReal(fmus[links[i].from].c, &links[i].from_vr, 1,
-                                                           &links[i].value));
-        for (i = 0; i < nl && st <= fmi2Warning; i++)
-            st = worst(st, fmus[links[i].to].lib.SetReal(fmus[links[i].to].c, &links[i].to_vr, 1, &links[i].value));
+        st = exchange(links, nl, st);
         if (st > fmi2Warning) {
             fprintf(stderr, "engine_host: the exchange at t = %.17g returned %s; stopping\n", t, status_name(st));
             code = st == fmi2Fatal ? 4 : 3;

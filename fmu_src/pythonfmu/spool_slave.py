@@ -170,9 +170,11 @@ class LPSpool(Fmi2Slave):
         ms = root.find("ModelStructure")
         outs = ms.find("Outputs")
         init = SubElement(ms, "InitialUnknowns")
+        # the initial speed is Omega0's, whatever torque the spool is given: no loop at initialisation either
+        params = " ".join(str(i + 1) for i, spec in enumerate(self._specs) if spec[2] == "parameter")
         for u in outs:
             u.set("dependencies", "")  # the outputs at t depend on the state only, not on the input at t
-            SubElement(init, "Unknown", index=u.get("index"))
+            SubElement(init, "Unknown", index=u.get("index"), dependencies=params)
         return root
 
     # ------------------------------------------------------------------ FMI life cycle
