@@ -484,7 +484,8 @@ i.free()
 
 def test_a_state_freed_by_value_is_freed_with_a_warning_not_a_crash(unzipped3):
     """fmusim 0.0.39 hands fmi3FreeFMUState the state itself, not the address of the variable holding it (a crash
-    of the host before): freed, with a warning, and the instance goes on. In a process of its own."""
+    of the host before): freed, with a logged warning and OK (fmusim stops at any other status), and the instance
+    goes on. In a process of its own."""
     import subprocess
     import sys
 
@@ -492,7 +493,7 @@ def test_a_state_freed_by_value_is_freed_with_a_warning_not_a_crash(unzipped3):
                        timeout=60, cwd=str(Path(__file__).resolve().parents[1]))
     assert r.returncode == 0, r.stderr[-2000:]
     out = dict(line.split(" ", 1) for line in r.stdout.splitlines())
-    assert out["status"] == str(WARNING) and out["step"] == str(OK)
+    assert out["status"] == str(OK) and out["step"] == str(OK)  # OK: fmusim ends its run at any other status
     assert "instead of a pointer to it" in out["log"]
 
 

@@ -309,7 +309,7 @@ static int substeps(model_runtime *m, double w, double h, char *msg, size_t len)
         double nd = rr_ceil(h / cap * (1.0 - 1e-9));
         if (!(nd <= MODEL_MAX_SUBSTEPS)) {
             char bh[32], bc[32], bt[32];
-            snprintf(msg, len, "communication step h = %s s needs %.3g substeps of at most %s s (dt_max, or half the "
+            snprintf(msg, len, "communication step h = %s s needs %.0f substeps of at most %s s (dt_max, or half the "
                      "central-difference limit at %g rad/s); at most %d are taken in one step (h <= %s s)",
                      core_num(h, bh, sizeof bh), nd, core_num(cap, bc, sizeof bc), band, MODEL_MAX_SUBSTEPS,
                      core_num(MODEL_MAX_SUBSTEPS * cap, bt, sizeof bt));
@@ -341,6 +341,20 @@ static void wear_outputs(model_runtime *m, model_values *v)
             v->r[WEAR_INDEX[k]] = out[k];
     }
     v->r[VR_CLEARANCE_EFFECTIVE] = m->g0 - closure + out[RR_WEAR_MEAN];
+}
+
+/* the engine's inputs into the casing's surface. A rigid liner with them at zero adds exactly 0 to every gap: the
+ * kernel then runs without the surface (the paper's loop, none of its cost); attached again as soon as anything is
+ * nonzero. Once worn, the liner stays attached (its depths are nonzero) */
+static void attach_surface(model_runtime *m, const model_values *v)
+{
+    m->surf.closure = v->r[VR_CLOSURE];
+    m->surf.offset_x = v->r[VR_OFFSET_X];
+    m->surf.offset_y = v->r[VR_OFFSET_Y];
+    m->contact.surface = m->surf.wears || m->surf.closure != 0.0 || m->surf.offset_x != 0.0 ||
+                                 m->surf.offset_y != 0.0
+                             ? &m->surf
+                             : NULL;
 }
 
 static model_status transient_step(model_runtime *m, model_values *v, double w, double me, double h, int to_event,
@@ -379,16 +393,7 @@ static model_status transient_step(model_runtime *m, model_values *v, double w, 
         }
         m->st.dt = dt;
     }
-    m->surf.closure = v->r[VR_CLOSURE];
-    m->surf.offset_x = v->r[VR_OFFSET_X];
-    m->surf.offset_y = v->r[VR_OFFSET_Y];
-    /* a rigid liner with the engine's inputs at zero adds exactly 0 to every gap: the kernel then runs without
-     * the surface (the paper's loop, none of its cost); attached again as soon as anything is nonzero. Once
-     * worn, the liner stays attached (its depths are nonzero) */
-    m->contact.surface = m->surf.wears || m->surf.closure != 0.0 || m->surf.offset_x != 0.0 ||
-                                 m->surf.offset_y != 0.0
-                             ? &m->surf
-                             : NULL;
+    attach_surface(m, v);
     m->job.n_steps = ns;
     m->job.omega = w;
     m->job.me = me;
@@ -536,7 +541,9 @@ model_status model_solve_now(model_runtime *m, model_values *v, double t, char *
     (void)t;
     if (g0 != m->g0) set_clearance(m, g0);
     if (m->mode != MODE_QUASI_STATIC) {
-        /* the outputs of the current state (transient: they do not depend on the inputs) */
+        /* the outputs of the current state against the casing as the engine's inputs place it (the initial
+         * outputs: a transient build reads no input after initialisation) */
+        attach_surface(m, v);
         m->surf.phi = m->st.phi;
         rr_outputs(&m->contact, m->q, NULL, v->r[VR_OMEGA], m->st.phi, OUTPUT_INDEX, v->r);
         finish_outputs(v, 0.0);

@@ -107,7 +107,7 @@ model_status model_step(model_runtime *m, model_values *v, double t, double h, c
     m->advanced = 0.0;
     if (!(nd <= MODEL_MAX_SUBSTEPS)) {
         char bh[32], bd[32], bt[32];
-        snprintf(msg, len, "communication step h = %s s needs %.3g substeps of at most dt_max = %s s; at most %d are "
+        snprintf(msg, len, "communication step h = %s s needs %.0f substeps of at most dt_max = %s s; at most %d are "
                  "taken in one step (h <= %s s); step refused, state unchanged", core_num(h, bh, sizeof bh), nd,
                  core_num(m->dt_max, bd, sizeof bd), MODEL_MAX_SUBSTEPS,
                  core_num(MODEL_MAX_SUBSTEPS * m->dt_max, bt, sizeof bt));
