@@ -71,3 +71,88 @@ def test_every_command_runs_on_the_configuration(name, tmp_path, capsys):
     assert run("wear", "--t-end", "3", "--speed", repr(s["speed"]), "--g0", repr(s["g0_mm"] * 1e-3),
                "--out", str(out / "wear")) == 0
     assert (out / "wear" / "3D" / "wear_profile.png").exists()
+
+
+# ------------------------------------------- defaults and limits from the configuration (issue 18, a newcomer's run)
+def _write(tmp_path, **changes) -> list[str]:
+    from rotorub_model.structure.params import from_dict
+
+    d = to_dict(reference_parameters().replace(**changes))
+    f = tmp_path / "my.toml"
+    f.write_text(to_toml(from_dict(d)))
+    return ["--params", str(f)]
+
+
+def _one_line(capsys, code: int, *needles: str) -> None:
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "\n" not in err and "Traceback" not in err, err
+    for n in needles:
+        assert n in err, err
+
+
+def test_the_speed_range_defaults_to_the_models_validity(tmp_path, capsys):
+    """speed_max = 6: response, Campbell and detection ran to a hard-coded 10 and refused their own default."""
+    base = _write(tmp_path, normalisation={"speed_max": 6.0})
+    assert main(["response", "--n-speeds", "200", "--out", str(tmp_path / "r"), *base]) == 0
+    s = json.loads((tmp_path / "r" / "summary.json").read_text())
+    assert s["speed_range"][1] == 6.0 and s["critical_speeds"][0] == pytest.approx(3.49, abs=0.01)
+    assert main(["campbell", "--n-speeds", "20", "--out", str(tmp_path / "c"), *base]) == 0
+    capsys.readouterr()
+
+
+def test_speeds_the_tool_chooses_stay_within_the_models_validity(tmp_path, capsys):
+    """speed_max = 2, below the first critical (3.49): the studies centred on it ran at 2.7-4.3 and 3.3 with exit
+    0; now they say there is no critical speed in the model's range."""
+    base = _write(tmp_path, normalisation={"speed_max": 2.0})
+    _one_line(capsys, main(["transient", "--out", str(tmp_path / "t"), *base]), "speed_max", "no critical speed")
+    _one_line(capsys, main(["stability", "--quick", "--out", str(tmp_path / "s"), *base]), "speed_max")
+    p = load_parameters(base[1])
+    speeds, _ = __import__("rotorub_model.app.studies", fromlist=["default_grid"]).default_grid(
+        build_model(p.replace(normalisation={"speed_max": 3.8})), quick=True)
+    assert speeds[-1] == 3.8  # clipped to the validity, not c1 + 0.8 = 4.29
+
+
+def test_no_imbalance_is_a_clear_error_where_a_study_needs_one(tmp_path, capsys):
+    """imbalance.me = 0: the studies crashed (IndexError: no critical speed among the response's peaks). The
+    response still finds the critical speeds (linear in me), with zero amplitudes; the studies say why not."""
+    base = _write(tmp_path, imbalance={"me": 0.0})
+    assert main(["response", "--n-speeds", "400", "--out", str(tmp_path / "r"), *base]) == 0
+    s = json.loads((tmp_path / "r" / "summary.json").read_text())
+    assert s["critical_speeds"][0] == pytest.approx(3.49, abs=0.01) and max(s["peak_amplitudes_m"]) == 0.0
+    capsys.readouterr()
+    for cmd in ("stability", "transient", "continuation"):
+        _one_line(capsys, main([cmd, "--out", str(tmp_path / cmd), *base]), "imbalance.me")
+
+
+def test_modes_and_static_default_to_the_configuration(tmp_path, capsys):
+    """modes at this configuration's first critical (not 3.5), static at it and at its contact.g0 (not 3.3 and
+    0.8 mm): a softer front bearing moves the critical down (3.45 from 3.49)."""
+    d = to_dict(reference_parameters())
+    d["bearings"][0]["k"] *= 0.5
+    d["contact"]["g0"] = 0.6e-3
+    from rotorub_model.structure.params import from_dict
+
+    f = tmp_path / "soft.toml"
+    f.write_text(to_toml(from_dict(d)))
+    assert main(["static", "--params", str(f), "--out", str(tmp_path / "st")]) == 0
+    s = json.loads((tmp_path / "st" / "summary.json").read_text())
+    from rotorub_model.app.studies import first_critical
+
+    c1 = first_critical(build_model(load_parameters(f)))[0]
+    assert s["g0_m"] == 0.6e-3 and s["speed"] == c1 and c1 < first_critical(build_model())[0] - 0.03
+    assert main(["modes", "--params", str(f), "--out", str(tmp_path / "m")]) == 0
+    assert json.loads((tmp_path / "m" / "modes.json").read_text())["speed"] == s["speed"]
+    capsys.readouterr()
+
+
+def test_a_missing_maps_folder_an_unwritable_out_and_coincident_bearings_are_refused(tmp_path, capsys):
+    _one_line(capsys, main(["transient", "--maps", str(tmp_path / "nowhere"), "--out", str(tmp_path / "t")]),
+              "--maps", "stability_2D.npz")
+    (tmp_path / "file").write_text("")
+    _one_line(capsys, main(["modes", "--speed", "3", "--out", str(tmp_path / "file" / "out")]), "file")
+    d = to_dict(reference_parameters())
+    d["bearings"][1]["z"] = d["bearings"][0]["z"]
+    from rotorub_model.structure.params import from_dict
+
+    with pytest.raises(Exception, match="bearings.*position of its own"):
+        from_dict(d)

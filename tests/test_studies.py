@@ -87,3 +87,30 @@ def test_a_configuration_without_a_point_says_so():
     model = build_model(reference_parameters().replace(contact={"mu": 0.3}))
     with pytest.raises(ParameterError, match="no cell of this configuration's stability maps"):
         pick_transient_point(model)
+
+
+def _small_imbalance():
+    """A newcomer's configuration (issue 18, its own review): a tenth of the imbalance, a sharper friction
+    regularisation, validity up to 6. The old picker took (3.49, 0.163 mm) from its clearance search, 2D unstable at
+    +0.028 1/s: a 20 s run grows 1.3-fold, and the study reported diverged_2d false without a word."""
+    return reference_parameters().replace(imbalance={"me": 2.0e-3}, contact={"slip_velocity": 0.01},
+                                          normalisation={"speed_max": 6.0})
+
+
+def test_the_point_picked_has_an_instability_the_run_shows(tmp_path):
+    """The chosen point's 2D eigenvalue is at least twice the rate the verdict can see in the run, so the 2D run
+    is seen to diverge and the 3D one to settle; the summary says where the point came from."""
+    model = build_model(_small_imbalance())
+    s = run_transient_study(model, tmp_path, progress=False)
+    pt = s["point"]
+    assert pt["instability_visible"] and pt["max_real_2d_per_s"] >= 4 * np.log(DIVERGENCE_GROWTH) / 20.0
+    assert pt["source"] in ("paper point", "stability maps") or pt["source"].startswith("clearance search")
+    assert s["diverged_2d"] is True and s["diverged_3d"] is False and s["settled_3d"]
+
+
+def test_a_run_too_short_to_judge_gets_no_verdict(tmp_path):
+    """A 2 s run (the imbalance ramp and one second): the growth cannot be fitted, so diverged is None with the
+    reason, not False (the 2D solution here is unstable: False would be wrong)."""
+    s = run_transient_study(build_model(), tmp_path, 3.3, 0.3347658066492542e-3, t_end=2.0, progress=False)
+    assert s["diverged_2d"] is None and s["diverged_3d"] is None and "shorter than 4 s" in s["verdict_note"]
+    assert s["static_2d"]["max_real_part"] > 0.1

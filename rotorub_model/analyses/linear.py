@@ -72,7 +72,8 @@ class ResponseResult:
             "peak_amplitudes_m": self.peak_amplitudes,
             "peak_tilts_rad": self.peak_tilts,
             "peak_ratio_first_to_second": (
-                self.peak_amplitudes[0] / self.peak_amplitudes[1] if len(self.peak_amplitudes) > 1 else None
+                self.peak_amplitudes[0] / self.peak_amplitudes[1]
+                if len(self.peak_amplitudes) > 1 and self.peak_amplitudes[1] > 0 else None
             ),
             "omega_ref_rad_s": self.omega_ref,
             "n_dofs": self.n_dofs,
@@ -82,10 +83,16 @@ class ResponseResult:
     def plot(self, path: str | Path) -> Path:
         plt = pyplot()
         fig, ax = plt.subplots(figsize=(7, 4))
-        ax.semilogy(self.speeds, self.amplitude * 1e3, lw=1.2)
-        for c, a in zip(self.critical_speeds, self.peak_amplitudes):
-            ax.plot(c, a * 1e3, "o", color="C3")
-            ax.annotate(f"Ω={c:.2f}", (c, a * 1e3), textcoords="offset points", xytext=(5, 5))
+        if self.amplitude.any():
+            ax.semilogy(self.speeds, self.amplitude * 1e3, lw=1.2)
+            for c, a in zip(self.critical_speeds, self.peak_amplitudes):
+                ax.plot(c, a * 1e3, "o", color="C3")
+                ax.annotate(f"Ω={c:.2f}", (c, a * 1e3), textcoords="offset points", xytext=(5, 5))
+        else:  # no imbalance (imbalance.me = 0): no response, the critical speeds still are where they are
+            ax.plot(self.speeds, self.amplitude * 1e3, lw=1.2)
+            for c in self.critical_speeds:
+                ax.axvline(c, color="C3", ls="--", lw=0.8)
+                ax.annotate(f"critical Ω={c:.2f}", (c, 0.0), textcoords="offset points", xytext=(5, 5))
         ax.set_xlabel("normalised spin speed Ω / Ω_ref")
         ax.set_ylabel("fan-disk displacement [mm]")
         ax.set_title("Imbalance response at the fan disk")
@@ -108,6 +115,10 @@ def run_response(
     _check_speed_range(speed_min, speed_max, n_speeds)
     wref = model.params.normalisation.omega_ref
     speeds = np.linspace(speed_min, speed_max, n_speeds)
+    me = model.params.imbalance.me if me is None else me
+    scale = 1.0
+    if me == 0.0:  # the response is linear in me: its peaks (the critical speeds) are found on a unit imbalance
+        me, scale = 1.0, 0.0
     T, R = model.disk_maps
     amp = np.empty(n_speeds)
     tilt = np.empty(n_speeds)
@@ -129,7 +140,8 @@ def run_response(
         crit.append(float(res.x))
         pamp.append(fan_amplitude(model, q))
         ptilt.append(float(np.hypot(*(R[:2] @ q))))
-    return ResponseResult(speeds, wref, amp, tilt, crit, pamp, ptilt, model.n_dofs)
+    return ResponseResult(speeds, wref, scale * amp, scale * tilt, crit, [scale * a for a in pamp],
+                          [scale * a for a in ptilt], model.n_dofs)
 
 
 def first_order(model: Model, omega: float, K_extra: np.ndarray | None = None,

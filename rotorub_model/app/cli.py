@@ -39,6 +39,24 @@ def arg(*args, **kwargs):
     return deco
 
 
+SPEED_MAX_HELP = ("highest normalised speed (default: the paper's 10, or the model's validity, normalisation.speed_max "
+                  "of the parameter file, when that is lower)")
+
+
+def resolve_defaults(ns: argparse.Namespace, p) -> None:
+    """The defaults that come from the configuration, filled in before the checks: the speed range's top from its
+    validity; modes and static at its own first critical speed, static at its own clearance (contact.g0)."""
+    if hasattr(ns, "speed_max") and ns.speed_max is None:
+        ns.speed_max = min(10.0, p.normalisation.speed_max)
+    if ns.command in ("modes", "static") and getattr(ns, "speed", None) is None:
+        from ..structure.model import build_model
+        from .studies import first_critical
+
+        ns.speed = first_critical(build_model(p))[0]
+    if ns.command == "static" and ns.g0 is None:
+        ns.g0 = p.contact.g0
+
+
 def check_arguments(ns: argparse.Namespace, p) -> None:
     """Every numeric argument against the model's validity, before any work (one-line ParameterError).
 
@@ -83,6 +101,10 @@ def check_arguments(ns: argparse.Namespace, p) -> None:
     v = getattr(ns, "formulation", None)
     if v is not None and v not in ("2D", "3D"):
         bad("formulation", v, "2D or 3D")
+    v = getattr(ns, "maps", None)
+    if v is not None and not all((Path(v) / f"stability_{f}.npz").is_file() for f in ("2D", "3D")):
+        raise ParameterError(f"--maps: {v!r} is not a stability study's folder (accepted: the --out DIR of rotorub "
+                             "stability, with stability_2D.npz and stability_3D.npz in it)")
 
 
 def _model(ns: argparse.Namespace):
@@ -93,7 +115,7 @@ def _model(ns: argparse.Namespace):
 
 @command("response", "imbalance response at the fan disk and critical speeds")
 @arg("--speed-min", type=float, default=0.05, help="lowest normalised speed")
-@arg("--speed-max", type=float, default=10.0, help="highest normalised speed")
+@arg("--speed-max", type=float, default=None, help=SPEED_MAX_HELP)
 @arg("--n-speeds", type=int, default=2000, help="number of speeds on the grid")
 def cmd_response(ns: argparse.Namespace) -> dict:
     from ..analyses.linear import run_response
@@ -102,7 +124,7 @@ def cmd_response(ns: argparse.Namespace) -> dict:
 
 
 @command("modes", "eigenvalues at one speed, labelled in the fixed frame")
-@arg("--speed", type=float, default=3.5, help="normalised spin speed")
+@arg("--speed", type=float, default=None, help="normalised spin speed (default: this configuration's first critical)")
 def cmd_modes(ns: argparse.Namespace) -> dict:
     from ..analyses.linear import run_modes
 
@@ -110,7 +132,7 @@ def cmd_modes(ns: argparse.Namespace) -> dict:
 
 
 @command("campbell", "Campbell diagram (fixed-frame frequencies)")
-@arg("--speed-max", type=float, default=10.0, help="highest normalised speed")
+@arg("--speed-max", type=float, default=None, help=SPEED_MAX_HELP)
 @arg("--n-speeds", type=int, default=400, help="number of speeds (one batched eigen-solve per cyclic block: "
      "400 take ~0.3 s)")
 def cmd_campbell(ns: argparse.Namespace) -> dict:
@@ -133,13 +155,20 @@ def _executor(ns: argparse.Namespace):
             raise ParameterError(
                 "--executor dask: dask.distributed is not installed (pip install 'rotorub[dask]')"
             ) from None
-        return Client(ns.dask_address).get_executor() if ns.dask_address else Client().get_executor()
+        try:
+            return Client(ns.dask_address).get_executor() if ns.dask_address else Client().get_executor()
+        except (OSError, TimeoutError) as exc:
+            from ..errors import ParameterError
+
+            raise ParameterError(f"--dask-address: {ns.dask_address or 'a local cluster'}: no scheduler answers "
+                                 f"({exc})") from None
     return None
 
 
 @command("static", "balanced static solution with contact at one point, and its stability")
-@arg("--speed", type=float, default=3.3, help="normalised spin speed")
-@arg("--g0", type=float, default=0.8e-3, help="nominal clearance [m]")
+@arg("--speed", type=float, default=None, help="normalised spin speed (default: this configuration's first "
+     "critical)")
+@arg("--g0", type=float, default=None, help="nominal clearance [m] (default: contact.g0 of the parameter file)")
 @arg("--formulation", default="3D", help="2D or 3D")
 def cmd_static(ns: argparse.Namespace) -> dict:
     from ..analyses.stability import stability_of
@@ -237,7 +266,7 @@ def cmd_wear(ns: argparse.Namespace) -> dict:
 
 @command("detect", "contact detection maps over (speed, g0): 2D, 3D, degraded 3D, theta and chord sweeps")
 @arg("--speed-min", type=float, default=0.05, help="lowest normalised speed")
-@arg("--speed-max", type=float, default=10.0, help="highest normalised speed")
+@arg("--speed-max", type=float, default=None, help=SPEED_MAX_HELP)
 @arg("--n-speeds", type=int, default=400, help="uniform speeds (critical speeds and a dense cluster added)")
 @arg("--n-g0", type=int, default=400, help="clearances on the map's g0 axis")
 @arg("--g0-max-mm", type=float, default=None, help="top of the g0 axis [mm] (default: 1.05 x largest closure)")
@@ -344,10 +373,15 @@ def main(argv: list[str] | None = None) -> int:
     ns = ap.parse_args(argv)
     fn = COMMANDS[ns.command][2]
     try:
-        check_arguments(ns, load_parameters(ns.params))
+        p = load_parameters(ns.params)
+        resolve_defaults(ns, p)
+        check_arguments(ns, p)
         result = fn(ns)
     except RotorubError as exc:
         print(f"rotorub {ns.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # the output folder (or a file in it) cannot be written, a file cannot be read
+        print(f"rotorub {ns.command}: error: {exc.filename or ''}: {exc.strerror or exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print(f"rotorub {ns.command}: interrupted", file=sys.stderr)

@@ -5,6 +5,7 @@ one stable.
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,20 +32,39 @@ DIVERGENCE_FIT_R2 = 0.9
 NO_GROWTH = {"rate_per_s": None, "factor": None, "window_s": None, "fit_r2": None}
 
 
+def first_critical(model: Model) -> tuple[float, float]:
+    """(first critical speed, the fan's peak amplitude there [m]) of this configuration's imbalance response
+    over its range of validity (up to normalisation.speed_max, at most the paper's 10): where its rub studies
+    centre. A configuration without imbalance, or without a critical speed in its range, gets a one-line
+    :class:`ParameterError`: the studies map the rub the imbalance drives through the first critical."""
+    from ..analyses.linear import run_response
+
+    p = model.params
+    if p.imbalance.me == 0.0:
+        raise ParameterError("imbalance.me: 0 kg m; the stability, transient and continuation studies need an "
+                             "imbalance (accepted range (0, inf) kg m): without one nothing touches for g0 >= 0")
+    top = min(10.0, p.normalisation.speed_max)
+    r = run_response(model, 0.05, top, n_speeds=max(80, int(80 * top)))
+    if not r.critical_speeds:
+        raise ParameterError(f"normalisation.speed_max: {p.normalisation.speed_max:g}; this configuration has no "
+                             f"critical speed in (0.05, {top:g}], where its rub studies centre: raise speed_max, or "
+                             "give the speeds")
+    return float(r.critical_speeds[0]), float(r.peak_amplitudes[0])
+
+
 def default_grid(model: Model, quick: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Speeds around the first critical and clearances up to its 3D closure.
+    """Speeds around the first critical (within the model's validity, speed_max) and clearances up to its 3D
+    closure.
 
     The quick grid spaces the clearances quadratically (denser near g0 = 0, where the
     contact region is thin away from the peak) so that its boundary is resolved.
     """
-    from ..analyses.linear import run_response
-
-    r = run_response(model, n_speeds=800)
-    c1 = r.critical_speeds[0]
-    gmax = 1.6 * r.peak_amplitudes[0]
+    c1, peak = first_critical(model)
+    lo, hi = max(c1 - 0.8, 0.05), min(c1 + 0.8, model.params.normalisation.speed_max)
+    gmax = 1.6 * peak
     if quick:
-        return np.linspace(max(c1 - 0.8, 0.05), c1 + 0.8, 40), gmax * np.linspace(0.0, 1.0, 36) ** 2
-    return np.linspace(max(c1 - 0.8, 0.05), c1 + 0.8, 100), np.linspace(0.0, gmax, 100)
+        return np.linspace(lo, hi, 40), gmax * np.linspace(0.0, 1.0, 36) ** 2
+    return np.linspace(lo, hi, 100), np.linspace(0.0, gmax, 100)
 
 
 def run_stability_study(model: Model, out: str | Path, quick: bool = False, speeds=None, g0s=None,
@@ -112,37 +132,71 @@ def point_status(model: Model, speed: float, g0: float) -> dict:
     return res
 
 
+@dataclass(frozen=True)
+class TransientPoint:
+    """Where a transient study runs, and why there."""
+
+    speed: float
+    g0: float
+    source: str  # "paper point", "clearance search at <speed>", "stability maps"
+    max_real_2d: float  # 1/s: the 2D static solution's leading eigenvalue (> 0: unstable)
+    visible: bool  # the 2D growth shows in the run (the verdict's measure, with a margin of 2 on the rate)
+    note: str = ""
+
+    def summary(self) -> dict:
+        return {"source": self.source, "max_real_2d_per_s": self.max_real_2d, "instability_visible": self.visible,
+                "note": self.note}
+
+
 def pick_transient_point(model: Model, stab_dir: str | Path | None = None, maps: dict | None = None,
                          progress: bool = False, t_end: float = 20.0) -> tuple[float, float]:
-    """A point where the 2D static solution is unstable and the 3D one stable, from this configuration.
+    """(speed, g0) of :func:`choose_transient_point`."""
+    pt = choose_transient_point(model, stab_dir, maps, progress, t_end)
+    return pt.speed, pt.g0
+
+
+def choose_transient_point(model: Model, stab_dir: str | Path | None = None, maps: dict | None = None,
+                           progress: bool = False, t_end: float = 20.0) -> TransientPoint:
+    """A point where the 2D static solution is unstable and the 3D one stable, from this configuration, where a
+    run of t_end shows the 2D instability (its growth e^(Re lambda t_end / 2) over the run's second half, the
+    verdict's measure, reaches DIVERGENCE_GROWTH with a margin of 2 on the rate). Candidates, in order; the
+    first with a visible instability is taken:
 
     1. The paper's point (3.3, 0.8 mm) when it qualifies and lies on this configuration's own map grid.
     2. A clearance search at the paper's speed when it is on the grid, else at this configuration's first
        critical speed (where the paper's point sits: the rub is strongest there): 160 clearances up to the
-       3D closure (the qualifying windows are ~0.02 mm wide, finer than any map), preferring an
-       instability the run will show (2D growth e^(Re lambda t_end / 2) of at least DIVERGENCE_GROWTH over
-       the second half, the verdict's measure; with a margin of 2 on the rate first), then three blades
-       touching in 2D and 3D, then the third 3D blade touching over a fraction of its chord nearest the
-       paper's 88 %.
-    3. Otherwise this configuration's stability maps (``maps``, else those saved in ``stab_dir``, else
-       the quick maps computed here): the qualifying cells, a visible instability first, then by margin
-       (all eight neighbours qualifying; at least two; the rest: a cell on the grid's edge counts its
-       missing neighbours as not qualifying, its region may go on beyond the map), the speed nearest the
-       first critical, three 2D blades, the middle of the speed's qualifying clearances; each candidate
-       checked at the point itself until one qualifies.
-    A configuration where none does gets a :class:`ParameterError` that says so.
+       3D closure (the qualifying windows are ~0.02 mm wide, finer than any map), preferring the most
+       visible instability, then three blades touching in 2D and 3D, then the third 3D blade touching over
+       a fraction of its chord nearest the paper's 88 %.
+    3. This configuration's stability maps (``maps``, else those saved in ``stab_dir``, else the quick maps
+       computed here): the qualifying cells, the most visible instability first, then by margin (all eight
+       neighbours qualifying; at least two; the rest: a cell on the grid's edge counts its missing neighbours
+       as not qualifying, its region may go on beyond the map), the speed nearest the first critical, three 2D
+       blades, the middle of the speed's qualifying clearances; each checked at the point itself.
+    Where no candidate's instability is visible, the most visible is taken and the point's ``note`` says how long
+    a run would show it. A configuration where none qualifies gets a :class:`ParameterError` that says so.
     """
     speeds, g0s = default_grid(model, quick=True)
+    # Re lambda the verdict sees in t_end: the envelope grows DIVERGENCE_GROWTH-fold over the second half
+    # at that rate, if the ringing has gone by then (measured: the fitted rate is 0.6-1.0 x lambda)
+    visible_rate = 2.0 * np.log(DIVERGENCE_GROWTH) / t_end
+    candidates: list[tuple[int, int, TransientPoint]] = []
+
+    def consider(order: int, speed: float, g0: float, source: str, max_real: float) -> TransientPoint | None:
+        vis = _visibility(max_real, visible_rate)
+        pt = TransientPoint(float(speed), float(g0), source, float(max_real), vis == 0)
+        candidates.append((vis, order, pt))
+        return pt if vis == 0 else None
+
     on_grid = speeds[0] <= PAPER_POINT[0] <= speeds[-1] and g0s[0] <= PAPER_POINT[1] <= g0s[-1]
-    if on_grid and _qualifies(point_status(model, *PAPER_POINT)):
-        return PAPER_POINT
+    if on_grid:
+        st = point_status(model, *PAPER_POINT)
+        if _qualifies(st) and (pt := consider(0, *PAPER_POINT, "paper point", st["2D"]["stability"].max_real)):
+            return pt
     from ..analyses.linear import linear_response, run_response
 
     crit = run_response(model, float(speeds[0]), float(speeds[-1]), 400).critical_speeds
     centre = float(crit[0]) if len(crit) else 0.5 * float(speeds[0] + speeds[-1])
-    # Re lambda the verdict sees in t_end: the envelope grows DIVERGENCE_GROWTH-fold over the second half
-    # at that rate, if the ringing has gone by then (measured: the fitted rate is 0.6-1.0 x lambda)
-    visible_rate = 2.0 * np.log(DIVERGENCE_GROWTH) / t_end
     speed = PAPER_POINT[0] if on_grid else centre
     q = linear_response(model, speed * model.params.normalisation.omega_ref)
     closure = float(-make_contact(model, "3D", g0=0.0).gaps(q).min())
@@ -154,11 +208,26 @@ def pick_transient_point(model: Model, stab_dir: str | Path | None = None, maps:
             fr = st["3D"]["static"].fractions
             part = fr[(fr > 0) & (fr < 1)]
             dist = float(np.min(np.abs(part - PAPER_PARTIAL))) if part.size else np.inf
-            found.append(((_visibility(st["2D"]["stability"].max_real, visible_rate), abs(n2 - 3), abs(n3 - 3),
-                           dist), float(g0)))
+            mr = st["2D"]["stability"].max_real
+            found.append(((_visibility(mr, visible_rate), abs(n2 - 3), abs(n3 - 3), dist), float(g0), mr))
     if found:
-        return speed, min(found)[1]
-    return _pick_from_maps(model, _stability_maps(model, stab_dir, maps, progress), centre, visible_rate)
+        _, g0, mr = min(found)
+        if pt := consider(1, speed, g0, f"clearance search at {speed:.4g}", mr):
+            return pt
+    try:
+        sp, g0, mr = _pick_from_maps(model, _stability_maps(model, stab_dir, maps, progress), centre, visible_rate)
+        if pt := consider(2, sp, g0, "stability maps", mr):
+            return pt
+    except ParameterError:
+        if not candidates:
+            raise
+    vis, _, pt = min(candidates, key=lambda c: (c[0], c[1]))
+    needed = 2.0 * np.log(DIVERGENCE_GROWTH) / pt.max_real_2d * 2.0  # the margin of 2 on the rate
+    return TransientPoint(pt.speed, pt.g0, pt.source, pt.max_real_2d, False,
+                          f"no qualifying point of this configuration has a 2D instability a {t_end:g} s run shows: "
+                          f"here Re lambda = {pt.max_real_2d:.3g} 1/s grows "
+                          f"{np.exp(pt.max_real_2d * t_end / 2):.3g}-fold over the run's second half (the verdict "
+                          f"needs {DIVERGENCE_GROWTH:g}); run --t-end {np.ceil(needed):.0f} s or longer to see it")
 
 
 def _visibility(max_real: float, visible_rate: float) -> int:
@@ -166,7 +235,8 @@ def _visibility(max_real: float, visible_rate: float) -> int:
     return 0 if max_real >= 2.0 * visible_rate else 1 if max_real >= visible_rate else 2
 
 
-def _pick_from_maps(model: Model, maps: tuple[dict, dict], centre: float, visible_rate: float) -> tuple[float, float]:
+def _pick_from_maps(model: Model, maps: tuple[dict, dict], centre: float,
+                    visible_rate: float) -> tuple[float, float, float]:
     from ..analyses.stability import RE_TOL
 
     m2, m3 = maps
@@ -187,8 +257,9 @@ def _pick_from_maps(model: Model, maps: tuple[dict, dict], centre: float, visibl
     cells.sort(key=lambda ij: (_visibility(r2[ij], visible_rate), int(tier[ij]), round(abs(sp[ij[0]] - centre), 9),
                                abs(int(m2["n_contact"][ij]) - 3), abs(ij[1] - mid[ij[0]])))
     for i, j in cells[:40]:
-        if _qualifies(point_status(model, float(sp[i]), float(g[j]))):
-            return float(sp[i]), float(g[j])
+        st = point_status(model, float(sp[i]), float(g[j]))
+        if _qualifies(st):
+            return float(sp[i]), float(g[j]), float(st["2D"]["stability"].max_real)
     raise ParameterError(f"transient point: {len(cells)} cells of this configuration's stability maps qualify "
                          f"(2D unstable, 3D stable) but none of the {min(len(cells), 40)} checked does at the "
                          "point itself (a region thinner than the grid); give --speed and --g0")
@@ -226,6 +297,7 @@ class TransientStudy:
     g0: float
     runs: dict[str, TransientResult]
     statics: dict
+    point: TransientPoint | None = None  # how the point was chosen (None: given)
 
     def summary(self) -> dict:
         r2, r3 = self.runs["2D"], self.runs["3D"]
@@ -247,8 +319,13 @@ class TransientStudy:
             "g0_mm": self.g0 * 1e3,
             # diverged: blew through the liner, or oscillates away from the static solution with an
             # envelope that grows 1.5-fold or more over the run's second half (diverging)
-            "diverged_2d": bool(r2.diverged or diverging(g2)),
-            "diverged_3d": bool(r3.diverged or diverging(g3)),
+            "diverged_2d": verdict(r2, g2),
+            "diverged_3d": verdict(r3, g3),
+            "verdict_note": "" if g2["factor"] is not None and g3["factor"] is not None else
+            "a run shorter than 4 s, or without a static solution to measure from, gets no growth verdict: "
+            "diverged is null unless the penetration limit was hit (the envelope's growth is fitted over the "
+            "second half of a run of at least 4 s)",
+            "point": self.point.summary() if self.point else {"source": "given"},
             "penetration_limit_hit": {"2D": r2.diverged, "3D": r3.diverged},
             "growth_after_ramp": {"2D": g2, "3D": g3},
             "settled_3d": settled(r3, st3.q) if st3.converged else False,
@@ -355,6 +432,14 @@ def diverging(growth: dict) -> bool:
     return bool(f is not None and f >= DIVERGENCE_GROWTH and (r2 or 0.0) >= DIVERGENCE_FIT_R2)
 
 
+def verdict(run: TransientResult, growth: dict) -> bool | None:
+    """Diverged: through the penetration limit, or :func:`diverging`; None where the growth could not be
+    measured (a run shorter than 4 s) and the limit was not hit: no verdict, rather than a false one."""
+    if run.diverged:
+        return True
+    return None if growth.get("factor") is None else diverging(growth)
+
+
 def growth_after_ramp(run: TransientResult, q_static: np.ndarray, t_from: float | None = None) -> dict:
     """:func:`envelope_growth` of |q - q_static|, the distance to the balanced static solution."""
     if run.q.shape[0] < 4:
@@ -377,13 +462,17 @@ def run_transient_study(model: Model, out: str | Path, speed: float | None = Non
     """Paper section 6: 2D and 3D transients at one point; picks the point if not given."""
     if (speed is None) != (g0 is None):
         raise ParameterError("transient point: give both --speed and --g0, or neither (automatic choice)")
+    point = None
     if speed is None:
-        speed, g0 = pick_transient_point(model, stab_dir, progress=progress, t_end=t_end)
+        point = choose_transient_point(model, stab_dir, progress=progress, t_end=t_end)
+        speed, g0 = point.speed, point.g0
+        if point.note:
+            print(f"rotorub transient: {point.note}", file=sys.stderr)
     omega = speed * model.params.normalisation.omega_ref
     statics = point_status(model, speed, g0)
     runs = {f: run_transient(model, make_contact(model, f, g0=g0), omega, t_end=t_end, progress=progress)
             for f in ("2D", "3D")}
-    return TransientStudy(speed, g0, runs, statics).save(out)
+    return TransientStudy(speed, g0, runs, statics, point).save(out)
 
 
 def run_wear_study(model: Model, out: str | Path, speed: float | None = None, g0: float | None = None,

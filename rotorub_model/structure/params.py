@@ -346,6 +346,11 @@ def _check_consistency(p: Parameters) -> None:
                 )
     if len(p.bearings) == 1:
         raise ParameterError("bearings: two or more bearings are needed to hold the shaft (got 1)")
+    zs = sorted((b.z, b.name) for b in p.bearings)
+    for (za, na), (zb, nb) in zip(zs, zs[1:]):
+        if zb - za <= 1e-6 * s.length:
+            raise ParameterError(f"bearings[{nb}].z: {zb:g} m is where bearings[{na}] is; accepted: a position of its "
+                                 "own (two bearings at one point hold the shaft like one: it pivots there)")
     if p.imbalance.disk not in [d.name for d in p.disks]:
         raise ParameterError(
             f"imbalance.disk: '{p.imbalance.disk}' is not a disk; accepted: {', '.join(d.name for d in p.disks)}"
