@@ -120,8 +120,8 @@ class WearResult:
         bax.set_xlabel("harmonic of the profile (lobes) [-]")
         bax.set_ylabel("amplitude [µm]")
         bax.set_xticks(range(1, 9))
-        bax.set_title(f"spectrum: {s['lobes']} lobes dominate; mean depth {s['depth_mean'] * 1e6:.3g} µm",
-                      fontsize=9)
+        lead = f"{s['lobes']} lobes dominate" if s["lobes"] else "no lobe dominates (no wear, or worn evenly)"
+        bax.set_title(f"spectrum: {lead}; mean depth {s['depth_mean'] * 1e6:.3g} µm", fontsize=9)
         bax.grid(alpha=0.3, axis="y")
         del bars
         fig.suptitle(self._title(), fontsize=10)
