@@ -1135,15 +1135,24 @@ static int newton(const rr_contact *c, double omega, int n, const double *K, con
 {
     double *J = work, *R = work + (size_t)n * n, *fnl = R + n, *dq = fnl + n, *qn = dq + n, *Rn = qn + n;
     double nr, scale;
-    int it, i, j;
-    /* |R| is measured against |lam F| (or the stiffness when there is no force) */
+    int it, i, j, no_force;
+    /* |R| is measured against |lam F|; with no such force (at rest, no imbalance) against the blades' contact
+     * forces, which a symmetric interference balances among themselves (1500 N a blade, a generalised force of
+     * 1e-12 N: balanced to 1e-13 N is converged), or else the stiffness */
     for (i = 0; i < n; ++i) R[i] = lam * F[i];
     scale = norm2(n, R);
-    if (1e-12 * knorm > scale) scale = 1e-12 * knorm;
+    no_force = 1e-12 * knorm > scale;
+    if (no_force) scale = 1e-12 * knorm;
     if (1e-30 > scale) scale = 1e-30;
     nr = residual(c, omega, n, K, F, lam, q, R, fnl);
     for (it = 1; it <= max_iter; ++it) {
         double step = 1.0, nn = 0.0;
+        if (no_force) { /* the per-blade laws residual() left in the contact's work: F_N first */
+            const double *law = c->work + (size_t)c->nb * c->np;
+            double total = 0.0;
+            for (j = 0; j < c->nb; ++j) total += fabs(law[(size_t)RR_LAW_WIDTH * j]);
+            if (total > scale) scale = total;
+        }
         if (nr <= tol * scale) {
             *rel = nr / scale;
             *its += it - 1;
