@@ -230,3 +230,19 @@ def test_transient_settles_on_the_orbit_born_at_the_hopf_point(hopf_3d, model, w
     assert re > 0.02
     assert ptp == pytest.approx(pred.disk_peak_to_peak, rel=0.02)
     assert period == pytest.approx(pred.period, rel=0.01)
+
+
+def test_the_trivial_multiplier_is_the_one_along_the_orbit():
+    """Near a Hopf point the amplitude's multiplier comes within the differences' error of the trivial one (1,
+    eigenvector along the flow). Measured on a newcomer's configuration: the trivial one read 1.0000061, the other
+    0.999996; removing the one nearest 1 left 1.0000061 and called a stable orbit unstable. Removed by its
+    eigenvector instead, the orbit is stable; without a direction the old rule stays."""
+    from rotorub_model.analyses.periodic import MULTIPLIER_TOL, _multipliers
+
+    rng = np.random.default_rng(3)
+    V = rng.standard_normal((6, 6))
+    rho = np.array([1.0000061, 0.999996, 0.8, 0.5, 0.3, 0.1])
+    D = V @ np.diag(rho) @ np.linalg.inv(V)
+    kept = _multipliers(D, along=V[:, 0] * 2.5)
+    assert np.abs(kept).max() == pytest.approx(0.999996, abs=1e-9) and np.abs(kept).max() < 1 + MULTIPLIER_TOL
+    assert np.abs(_multipliers(D)).max() == pytest.approx(1.0000061, abs=1e-9)  # the nearest-to-1 rule

@@ -127,9 +127,19 @@ class Shooting:
                      float(r.mean()), fmax, float(residual), float(r.max()), float(r.min()))
 
 
-def _multipliers(D: np.ndarray) -> np.ndarray:
-    rho = np.linalg.eigvals(D)
-    k = int(np.argmin(np.abs(rho - 1.0)))  # the trivial multiplier (a shift along the orbit)
+def _multipliers(D: np.ndarray, along: np.ndarray | None = None) -> np.ndarray:
+    """The Floquet multipliers of the monodromy D, the trivial one removed (a shift along the orbit: its
+    eigenvector is the flow's direction ``along``). Near a Hopf point a second multiplier comes close to 1 (the
+    orbit's amplitude), within the differences' error of the trivial one: the trivial one is then the one whose
+    eigenvector lies along the orbit, not merely the one nearest 1 (on a newcomer's configuration the first
+    orbit past a Hopf point read 1.000006, the trivial one, and was called unstable)."""
+    rho, vec = np.linalg.eig(D)
+    near = np.flatnonzero(np.abs(rho - 1.0) < 1e-3)
+    if along is not None and near.size > 1 and np.linalg.norm(along) > 0:
+        cos = np.abs(vec[:, near].conj().T @ along) / (np.linalg.norm(vec[:, near], axis=0) * np.linalg.norm(along))
+        k = int(near[np.argmax(cos)])
+    else:
+        k = int(np.argmin(np.abs(rho - 1.0)))
     rho = np.delete(rho, k)
     return rho[np.argsort(-np.abs(rho))]
 
@@ -167,6 +177,14 @@ class _OrbitSolver:
                 return None
             J[:, i] = (fp - f0) / h
         return J
+
+    def along(self, z) -> np.ndarray | None:
+        """The flow's direction at the orbit's point, in the scaled coordinates of :meth:`monodromy`: the
+        trivial multiplier's eigenvector (a 1/256 of a period forward, one-sided: a direction is all it gives)."""
+        x, T, g0 = self.unpack(z)
+        d = T / 256
+        xd = self.sh.flow(x, d, g0)
+        return None if xd is None else (xd - x) / d / self.xs
 
     def monodromy(self, z) -> np.ndarray | None:
         """dPhi_T/dx at the orbit by central differences (Floquet multipliers to ~1e-8; the forward
@@ -256,7 +274,8 @@ def _follow(solver: _OrbitSolver, z: np.ndarray, tau: np.ndarray, g0_from: float
             continue
         x, T, g0 = solver.unpack(z_new)
         D = solver.monodromy(z_new)
-        o = sh.orbit(x, T, g0, res, _multipliers(D if D is not None else J[:2 * n, :2 * n] + np.eye(2 * n)))
+        o = sh.orbit(x, T, g0, res, _multipliers(D if D is not None else J[:2 * n, :2 * n] + np.eye(2 * n),
+                                                 solver.along(z_new)))
         if o.trivial:
             return orbits, f"the orbits shrank onto the static solution at g0 = {g0:.6g} m"
         orbits.append(o)
@@ -321,5 +340,6 @@ def orbit_from_state(eq: Equilibria, omega: float, g0: float, q: np.ndarray, qdo
         return None
     x, T, g = solver.unpack(z)
     D = solver.monodromy(z)
-    o = sh.orbit(x, T, g, res, _multipliers(D if D is not None else J[:2 * n, :2 * n] + np.eye(2 * n)))
+    o = sh.orbit(x, T, g, res, _multipliers(D if D is not None else J[:2 * n, :2 * n] + np.eye(2 * n),
+                                            solver.along(z)))
     return None if o.trivial else o
