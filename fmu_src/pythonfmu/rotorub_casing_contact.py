@@ -217,7 +217,9 @@ class RotorCasingContact(Fmi2Slave):
             if not self._is_real[idx].all():
                 raise TypeError(f"get_real: value reference(s) {idx[~self._is_real[idx]].tolist()} are not Real")
             self._get_memo = (list(vrs), idx)
-        if self._stale and self._feedthrough:
+        if self._phase == "initialization":
+            self._initial_outputs()
+        elif self._stale and self._feedthrough:
             self._refresh()
         return self._rv.take(idx).tolist()
 
@@ -226,7 +228,9 @@ class RotorCasingContact(Fmi2Slave):
         idx = np.asarray(vrs, dtype=np.intp)
         if not self._is_int[idx].all():
             raise TypeError(f"get_integer: value reference(s) {idx[~self._is_int[idx]].tolist()} are not Integer")
-        if self._stale and self._feedthrough:
+        if self._phase == "initialization":
+            self._initial_outputs()
+        elif self._stale and self._feedthrough:
             self._refresh()
         return self._iv[idx].tolist()
 
@@ -270,6 +274,17 @@ class RotorCasingContact(Fmi2Slave):
 
     def enter_initialization_mode(self, *args):
         self._phase = "initialization"
+
+    def _initial_outputs(self) -> None:
+        """As the native FMU: in initialization mode the outputs are the initial state's, from a model built with
+        the values set so far; a combination that does not hold yet is no error here (exit reports it). The model
+        is not kept: exit builds it again with the final values."""
+        try:
+            self._build(provisional=True)
+        except Exception:  # noqa: BLE001 - the master may still be setting values; exit reports it
+            pass
+        finally:
+            self._sim = None
 
     def exit_initialization_mode(self, *args):
         self._phase = "step"
@@ -326,8 +341,9 @@ class RotorCasingContact(Fmi2Slave):
                                                      "slip_velocity", "yield_force", "hardening", "liner_thickness")},
                 "liner": enum["Liner"][self._i("liner") - 1][0], "n_sectors": self._i("n_sectors")}
 
-    def _build(self, config: dict | None = None) -> None:
-        """Build model, contact and solver from the parameters (raises with a message naming the cause)."""
+    def _build(self, config: dict | None = None, provisional: bool = False) -> None:
+        """Build model, contact and solver from the parameters (raises with a message naming the cause);
+        ``provisional``: for the outputs of initialization mode, nothing reported."""
         lib = self._lib
         cfg = config or self._config()
         self._fatal_msg = None
@@ -367,22 +383,27 @@ class RotorCasingContact(Fmi2Slave):
                                        radius=params.blades.tip_radius,
                                        band=cfg["chord"] * math.cos(math.radians(params.blades.stagger_deg)),
                                        tip_area=params.blades.thickness * cfg["chord"])
+        closure, offset = self._r("clearance_closure"), (self._r("casing_offset.x"), self._r("casing_offset.y"))
+        sim["liner"].set_inputs(closure, offset)
+        surface = sim["liner"].wears or closure != 0.0 or offset != (0.0, 0.0)
         if sim["transient"]:
             sim["cd"] = lib.transient.CentralDifference(model, contact, dt=None, t_ramp=0.0,
                                                         max_penetration=cfg["max_penetration"],
                                                         omega_max_for_dt=self._r("Omega"), liner=sim["liner"])
             sim["cd"].bind_outputs(self._out_index, self._rv)
+            sim["cd"].use_liner(surface)
             q = sim["cd"].q
         else:
             q = np.zeros(model.n_dofs)
         self._sim = sim
         self._iv[self._i_status] = self._if.STATUS_OK
-        self._write_outputs(q, self._r("Omega"), 0.0, max_real=0.0)
+        # the initial state against the casing as the engine's inputs place it (as the native FMU)
+        self._write_outputs(q, self._r("Omega"), 0.0, max_real=0.0, liner=sim["liner"] if surface else None)
         self._write_wear()
         self._stale = False
         if not sim["transient"]:
             ok, msg = self._quasi_static(self._r("Omega"), self._r("imbalance"), 0.0)
-            if not ok:  # no balanced solution at the initial inputs: the first step says it again
+            if not ok and not provisional:  # no balanced solution at the initial inputs: the first step says it again
                 self._report(self._if.STATUS_DIVERGED, msg)
 
     # ------------------------------------------------------------------ stepping
@@ -555,10 +576,11 @@ class RotorCasingContact(Fmi2Slave):
         if not ok:
             self._report(self._if.STATUS_DIVERGED, msg)
 
-    def _write_outputs(self, q: np.ndarray, omega: float, phi: float, max_real: float, contact=None) -> None:
+    def _write_outputs(self, q: np.ndarray, omega: float, phi: float, max_real: float, contact=None,
+                       liner=None) -> None:
         """The outputs of state q at rest in the rotating frame (the kernel's, as in every library
-        analysis) at spin omega, fixed frame at angle phi."""
-        (contact or self._sim["contact"]).write_outputs(q, None, omega, phi, self._out_index, self._rv)
+        analysis) at spin omega, fixed frame at angle phi (against ``liner``'s surface when given)."""
+        (contact or self._sim["contact"]).write_outputs(q, None, omega, phi, self._out_index, self._rv, liner=liner)
         self._iv[self._i_nc] = int(self._rv[self._i_nc])
         self._rv[self._i_maxre] = max_real
 

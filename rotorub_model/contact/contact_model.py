@@ -252,12 +252,12 @@ class ContactModel:
         }
 
     def write_outputs(self, q: np.ndarray, qdot: np.ndarray | None, omega: float, phi: float, index: np.ndarray,
-                      dest: np.ndarray) -> None:
+                      dest: np.ndarray, liner=None) -> None:
         """The outputs of state (q, q') at spin omega, fixed frame at angle phi, written to
         dest[index[k]] (an FMU's value buffer; ``index``: intc array in the kernel's order,
-        ``dest``: float64)."""
+        ``dest``: float64); with ``liner`` (contact.liner.Liner), against its surface (worn, closed, offset)."""
         q, qd = np.ascontiguousarray(q, dtype=float), self._velocity(qdot)
-        k = self.kernel
+        k = self.kernel if liner is None else liner.attach(self.kernel)
         self._lib.rr_outputs(k, kernel.ptr(q), None if qd is None else kernel.ptr(qd), float(omega), float(phi),
                              kernel.iptr(index), kernel.ptr(dest))
 
