@@ -95,7 +95,8 @@ class ResponseResult:
                 ax.annotate(f"critical Ω={c:.2f}", (c, 0.0), textcoords="offset points", xytext=(5, 5))
         ax.set_xlabel("normalised spin speed Ω / Ω_ref")
         ax.set_ylabel("fan-disk displacement [mm]")
-        ax.set_title("Imbalance response at the fan disk")
+        ax.set_title("Imbalance response at the fan disk" + ("" if self.amplitude.any() else
+                                                               " (no imbalance: imbalance.me = 0)"))
         ax.grid(True, which="both", alpha=0.3)
         return save_figure(fig, path)
 
