@@ -156,3 +156,39 @@ def test_a_missing_maps_folder_an_unwritable_out_and_coincident_bearings_are_ref
 
     with pytest.raises(Exception, match="bearings.*position of its own"):
         from_dict(d)
+
+
+# ------------------------------------------------------------------- a second newcomer's configurations
+def test_two_blades_are_refused_with_the_reason(tmp_path, capsys):
+    """Two blades make the bladed disk anisotropic: between its split critical speeds the rotating frame's static
+    response is unbounded (a newcomer's run: 'peaks' of 2 and 10 km, a map axis of 1.2e7 mm, an empty figure)."""
+    from rotorub_model.errors import ParameterError
+
+    with pytest.raises(ParameterError, match="blades.count.*accepted range \\[3"):
+        reference_parameters().replace(blades={"count": 2})
+    d = to_dict(reference_parameters())
+    d["blades"]["count"] = 3  # three hold the rotor isotropic: runs
+    from rotorub_model.structure.params import from_dict
+
+    assert build_model(from_dict(d)).n_dofs == 18 + 3 * 2
+
+
+def test_a_first_critical_beyond_the_validity_says_what_to_do(tmp_path, capsys):
+    """A shaft so stiff that its first critical lies beyond the model's validity: the response says there is none
+    in its range, the studies refuse in one line that names the way out, detection too without imbalance."""
+    d = to_dict(reference_parameters())
+    d["shaft"]["outer_diameter"], d["shaft"]["inner_diameter"] = 0.30, 0.26
+    d["normalisation"]["speed_max"] = 6.0
+    from rotorub_model.structure.params import from_dict
+
+    f = tmp_path / "stiff.toml"
+    f.write_text(to_toml(from_dict(d)))
+    assert main(["response", "--n-speeds", "200", "--params", str(f), "--out", str(tmp_path / "r")]) == 0
+    s = json.loads((tmp_path / "r" / "summary.json").read_text())
+    assert s["critical_speeds"] == [] and "no critical speed in" in s["note"]
+    capsys.readouterr()
+    _one_line(capsys, main(["stability", "--quick", "--params", str(f), "--out", str(tmp_path / "s")]),
+              "no critical speed", "--speed and --g0")
+    base = _write(tmp_path, imbalance={"me": 0.0})
+    _one_line(capsys, main(["detect", "--n-speeds", "40", "--n-g0", "20", "--out", str(tmp_path / "d"), *base]),
+              "imbalance.me")

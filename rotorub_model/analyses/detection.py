@@ -402,6 +402,9 @@ def run_detection(
     """
     from tqdm import tqdm
 
+    if model.params.imbalance.me == 0.0:
+        raise ParameterError("imbalance.me: 0 kg m; the detection maps put the imbalance response into the gaps "
+                             "(accepted range (0, inf) kg m): without an imbalance every closure is 0")
     if isinstance(n_g0, bool) or not isinstance(n_g0, int | np.integer) or not 2 <= n_g0 <= 100_000:
         raise ParameterError(f"n_g0: {n_g0!r} out of range; accepted: integers in [2, 100000]")
     if g0_max is not None and not (np.isfinite(g0_max) and g0_max > 0):

@@ -78,6 +78,9 @@ class ResponseResult:
             "omega_ref_rad_s": self.omega_ref,
             "n_dofs": self.n_dofs,
             "speed_range": [float(self.speeds[0]), float(self.speeds[-1])],
+            "note": "" if self.critical_speeds else
+            f"no critical speed in [{self.speeds[0]:g}, {self.speeds[-1]:g}]: the response grows monotonically "
+            "(the first critical lies beyond the range; the rub studies need one within the model's validity)",
         }
 
     def plot(self, path: str | Path) -> Path:

@@ -374,6 +374,7 @@ def main(argv: list[str] | None = None) -> int:
     fn = COMMANDS[ns.command][2]
     try:
         p = load_parameters(ns.params)
+        check_arguments(ns, p)  # what was given, before the defaults that cost a response (the first critical)
         resolve_defaults(ns, p)
         check_arguments(ns, p)
         result = fn(ns)

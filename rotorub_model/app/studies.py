@@ -43,12 +43,16 @@ def first_critical(model: Model) -> tuple[float, float]:
     if p.imbalance.me == 0.0:
         raise ParameterError("imbalance.me: 0 kg m; the stability, transient and continuation studies need an "
                              "imbalance (accepted range (0, inf) kg m): without one nothing touches for g0 >= 0")
-    top = min(10.0, p.normalisation.speed_max)
+    smax = p.normalisation.speed_max
+    top = min(10.0, smax)
     r = run_response(model, 0.05, top, n_speeds=max(80, int(80 * top)))
+    if not r.critical_speeds and smax > 10.0:  # beyond the paper's range, within the model's validity
+        r = run_response(model, 10.0, smax, n_speeds=max(80, int(80 * (smax - 10.0))))
     if not r.critical_speeds:
-        raise ParameterError(f"normalisation.speed_max: {p.normalisation.speed_max:g}; this configuration has no "
-                             f"critical speed in (0.05, {top:g}], where its rub studies centre: raise speed_max, or "
-                             "give the speeds")
+        raise ParameterError(f"normalisation.speed_max: {smax:g}; this configuration has no critical speed in "
+                             f"(0.05, {smax:g}], and its stability, transient and continuation studies centre on the "
+                             "first one: raise speed_max if the model holds beyond it; otherwise give `transient` "
+                             "a --speed and --g0 (static, modes: a --speed)")
     return float(r.critical_speeds[0]), float(r.peak_amplitudes[0])
 
 
@@ -224,10 +228,12 @@ def choose_transient_point(model: Model, stab_dir: str | Path | None = None, map
     vis, _, pt = min(candidates, key=lambda c: (c[0], c[1]))
     needed = 2.0 * np.log(DIVERGENCE_GROWTH) / pt.max_real_2d * 2.0  # the margin of 2 on the rate
     return TransientPoint(pt.speed, pt.g0, pt.source, pt.max_real_2d, False,
-                          f"no qualifying point of this configuration has a 2D instability a {t_end:g} s run shows: "
-                          f"here Re lambda = {pt.max_real_2d:.3g} 1/s grows "
-                          f"{np.exp(pt.max_real_2d * t_end / 2):.3g}-fold over the run's second half (the verdict "
-                          f"needs {DIVERGENCE_GROWTH:g}); run --t-end {np.ceil(needed):.0f} s or longer to see it")
+                          f"no qualifying point of this configuration has a 2D instability fast enough for a "
+                          f"{t_end:g} s run: the picker asks for Re lambda >= {2 * visible_rate:.3g} 1/s (twice the "
+                          f"rate at which the envelope grows {DIVERGENCE_GROWTH:g}-fold over the second half, a "
+                          f"margin for the ringing and the contact changes on the way), here {pt.max_real_2d:.3g} "
+                          f"1/s; the run may or may not show it: --t-end {np.ceil(needed):.0f} s or longer meets "
+                          "the margin")
 
 
 def _visibility(max_real: float, visible_rate: float) -> int:

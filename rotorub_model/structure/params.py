@@ -80,7 +80,9 @@ class DiskParams:
 
 @dataclass(frozen=True)
 class BladeParams:
-    count: int = _f(2, 200, integer=True, doc="number of blades")
+    count: int = _f(3, 200, integer=True, doc="number of blades (3 or more: with two the bladed disk is "
+                                              "anisotropic, its split critical speeds bound a band where the "
+                                              "rotating frame's static response is unbounded)")
     hub_radius: float = _f(0, lo_open=True, doc="clamping radius r_d on the fan disk [m]")
     length: float = _f(0, lo_open=True, doc="blade length l_b [m]")
     width: float = _f(0, lo_open=True, doc="section width (chord of the beam section) [m]")
