@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 
 from rotorub_model.analyses import branch as branch_mod
+from rotorub_model.analyses.boundary import trace_boundaries
 from rotorub_model.analyses.branch import HOPF_TOL, Branch, continue_static
-from rotorub_model.analyses.continuation import PAPER_SPEED, ContinuationResult, off_branch, run_continuation
+from rotorub_model.analyses.continuation import PAPER_SPEED, ContinuationResult, agreement, off_branch, run_continuation
 from rotorub_model.analyses.equilibria import Equilibria
 from rotorub_model.analyses.linear import run_response
 from rotorub_model.analyses.maps import StabilityMap, run_stability_map
@@ -286,3 +287,19 @@ def test_orbits_are_drawn_on_their_static_branch(study, name):
                     assert o.disk_min_radius <= static <= o.disk_max_radius, (f, o.g0)
             checked += 1
     assert checked >= 1  # every configuration has a 3D Hopf point with its orbits
+
+
+def test_thirty_blades_2d_boundaries_meet_at_their_corners():
+    """A second newcomer's 30 blades (3 polynomials reduced to 2 modes, 78 dofs). The 2D first-contact switch stops
+    being a stability boundary where the contact solution turns stable, and the boundary goes on as a curve shorter
+    than a seed-lattice cell; the curves also stopped short of the corner where they meet. One gap flooded the map:
+    one region, 362 cells 'contradicting' (202 beyond one cell). Now: the free ends' local lattices seed the
+    missing curve, ends within a cell of another curve meet it, and no followed-branch cell beyond one cell
+    contradicts the curves (measured: 4 contradicting, all within one cell)."""
+    m = build_model(reference_parameters().replace(blades={"count": 30, "n_ritz": 3, "n_modes": 2}))
+    speeds, g0s = default_grid(m, quick=True)
+    mp = run_stability_map(m, "2D", speeds, g0s, executor="serial", progress=False)
+    curves, info = trace_boundaries(Equilibria(m, "2D"), speeds, g0s)
+    a = agreement(curves, mp, tuple(info["cell"]))
+    assert a["regions"] >= 2 and a["contradicting_cells"] < 20, a
+    assert a["contradicting_beyond_one_cell"] - a["contradicting_beyond_one_cell_off_branch"] == 0, a

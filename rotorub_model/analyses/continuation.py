@@ -183,18 +183,52 @@ def _legend(ax) -> None:
     ax.legend(uniq.values(), uniq.keys(), fontsize=7)
 
 
+def _junctions(polys: list[np.ndarray]) -> list[np.ndarray]:
+    """Where boundaries of different kinds meet (a switch turning into a Hopf curve at a corner) the correctors
+    stop short of the corner, and a curve can end less than a cell from the one it meets. Such an end is joined to
+    the nearest point of the other curve (a segment shorter than a cell, at the resolution the agreement is
+    judged): a gap there would connect the regions on both sides, and one gap floods a whole map (30 blades, 2D:
+    one region, every stable cell 'contradicting'). Returns the joining segments (scaled coordinates)."""
+    out = []
+    for i, P in enumerate(polys):
+        if len(P) < 2 or np.linalg.norm(P[0] - P[-1]) < 1e-9:
+            continue
+        for e in (P[0], P[-1]):
+            best, where = 1.0, None
+            for j, Q in enumerate(polys):
+                if j == i or len(Q) == 0:
+                    continue
+                if len(Q) == 1:
+                    x, d = Q[0], float(np.linalg.norm(Q[0] - e))
+                else:
+                    a, b = Q[:-1], Q[1:]
+                    t = np.clip(np.einsum("ij,ij->i", e - a, b - a) / np.maximum(np.einsum("ij,ij->i", b - a, b - a),
+                                                                                 1e-30), 0.0, 1.0)
+                    X = a + t[:, None] * (b - a)
+                    k = int(np.argmin(np.linalg.norm(X - e, axis=1)))
+                    x, d = X[k], float(np.linalg.norm(X[k] - e))
+                if 1e-12 < d < best:
+                    best, where = d, x
+            if where is not None:
+                out.append(np.array([e, where]))
+    return out
+
+
 def agreement(curves: list[Curve], mp: StabilityMap, cell: tuple[float, float]) -> dict:
     """Grid cells whose verdict contradicts the side of the boundary curves they lie on.
 
     The curves cut the grid into regions (grid neighbours are connected unless a curve passes
-    between them; cells without an equilibrium are left out): inside a region the curves say the
+    between them, a curve's end joined to another curve less than a cell away: :func:`_junctions`; cells
+    without an equilibrium are left out): inside a region the curves say the
     verdict is one. A region's verdict is its majority; a cell that disagrees contradicts the curves,
     and should lie within one cell of one (a boundary the tracer missed leaves the cells on its far
     side contradicting, away from every curve)."""
     ns, ng = len(mp.speeds), len(mp.g0s)
     xy = np.stack(np.meshgrid(mp.speeds / cell[0], mp.g0s / cell[1], indexing="ij"), axis=-1)
-    segs = [np.array([[s / cell[0], g / cell[1]] for s, g in zip(c.speeds, c.g0s)]) for c in curves]
-    segs = [np.stack([P[:-1], P[1:]], axis=1) for P in segs if len(P) > 1]
+    polys = [np.array([[s / cell[0], g / cell[1]] for s, g in zip(c.speeds, c.g0s)]) for c in curves]
+    segs = [np.stack([P[:-1], P[1:]], axis=1) for P in polys if len(P) > 1]
+    junctions = _junctions(polys)
+    segs += [np.array([j]) for j in junctions]
     S = np.concatenate(segs) if segs else np.zeros((0, 2, 2))
     valid = ~mp.no_solution
     parent = np.arange(ns * ng)
@@ -230,6 +264,7 @@ def agreement(curves: list[Curve], mp: StabilityMap, cell: tuple[float, float]) 
     off = off_branch(mp)
     n_valid = max(int(valid.sum()), 1)
     out = {"grid_cells": int(valid.sum()), "regions": int(len(np.unique(roots[valid]))),
+           "junctions_closed": len(junctions),
            "contradicting_cells": int(bad.sum()), "contradicting_fraction": float(bad.sum() / n_valid),
            "contradicting_beyond_one_cell": int(beyond.sum()),
            "contradicting_beyond_one_cell_fraction": float(beyond.sum() / n_valid),
