@@ -418,7 +418,9 @@ def run_continuation(model: Model, maps: dict[str, StabilityMap] | None = None, 
         orbits[f] = _orbits(eq, b, omega, max_orbits) if b.points else []
         timings[f"orbits_{f}"] = time.perf_counter() - t0
         if progress:
-            print(f"continuation {f}: branch {len(b.points)} points, {len(b.specials)} special points")
+            n_contact = len(b.of_kind("contact"))  # as the summary counts them: contact events apart
+            print(f"continuation {f}: branch {len(b.points)} points, {len(b.specials) - n_contact} special points "
+                  f"and {n_contact} contact events")
         if boundaries:
             t0 = time.perf_counter()
             cv, info = trace_boundaries(eq, np.asarray(speeds), np.asarray(g0s))
