@@ -192,3 +192,18 @@ def test_a_first_critical_beyond_the_validity_says_what_to_do(tmp_path, capsys):
     base = _write(tmp_path, imbalance={"me": 0.0})
     _one_line(capsys, main(["detect", "--n-speeds", "40", "--n-g0", "20", "--out", str(tmp_path / "d"), *base]),
               "imbalance.me")
+
+
+def test_a_response_beyond_small_displacements_is_flagged():
+    """Bearings ten times stiffer lock the dampers (they act only where the bearings move): the fan's linear peak is
+    485 mm, half the tip radius, and nothing said so. The summary warns beyond 5 % of the tip radius; the
+    reference (5.2 mm) does not."""
+    from rotorub_model.analyses.linear import run_response
+    from rotorub_model.structure.params import from_dict
+
+    d = to_dict(reference_parameters())
+    for b in d["bearings"]:
+        b["k"] *= 10
+    s = run_response(build_model(from_dict(d)), n_speeds=800).summary()
+    assert "beyond the small displacements" in s["warning"] and max(s["peak_amplitudes_m"]) > 0.4
+    assert run_response(build_model(), n_speeds=800).summary()["warning"] == ""

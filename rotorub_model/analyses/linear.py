@@ -64,6 +64,7 @@ class ResponseResult:
     peak_amplitudes: list[float]  # [m]
     peak_tilts: list[float]  # [rad]
     n_dofs: int
+    warning: str = ""  # a response beyond what the model is written for
 
     def summary(self) -> dict:
         return {
@@ -81,6 +82,7 @@ class ResponseResult:
             "note": "" if self.critical_speeds else
             f"no critical speed in [{self.speeds[0]:g}, {self.speeds[-1]:g}]: the response grows monotonically "
             "(the first critical lies beyond the range; the rub studies need one within the model's validity)",
+            "warning": self.warning,
         }
 
     def plot(self, path: str | Path) -> Path:
@@ -144,8 +146,14 @@ def run_response(
         crit.append(float(res.x))
         pamp.append(fan_amplitude(model, q))
         ptilt.append(float(np.hypot(*(R[:2] @ q))))
+    warning = ""
+    r_tip = model.params.blades.tip_radius
+    if scale and pamp and max(pamp) > 0.05 * r_tip:  # small rotations and a linear casing gap: a few mm, not dm
+        warning = (f"the fan disk's peak displacement {max(pamp) * 1e3:.3g} mm is {100 * max(pamp) / r_tip:.2g} % of "
+                   "the tip radius: beyond the small displacements the model is written for (too little damping "
+                   "at the critical speed? the bearings' dampers act only where the bearings move)")
     return ResponseResult(speeds, wref, scale * amp, scale * tilt, crit, [scale * a for a in pamp],
-                          [scale * a for a in ptilt], model.n_dofs)
+                          [scale * a for a in ptilt], model.n_dofs, warning)
 
 
 def first_order(model: Model, omega: float, K_extra: np.ndarray | None = None,
