@@ -791,14 +791,21 @@ class BoundaryTracer:
         return None
 
 
-def _distance_to_polyline(x: np.ndarray, P: np.ndarray) -> float:
-    """Distance from x to the polyline through the points P (scaled coordinates)."""
+def nearest_on_polyline(x: np.ndarray, P: np.ndarray) -> tuple[np.ndarray, float]:
+    """The point of the polyline through the points P nearest to x, and its distance (scaled coordinates)."""
     if len(P) == 1:
-        return float(np.linalg.norm(x - P[0]))
+        return P[0], float(np.linalg.norm(x - P[0]))
     a, b = P[:-1], P[1:]
     d = b - a
     t = np.clip(np.einsum("ij,ij->i", x - a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-30), 0.0, 1.0)
-    return float(np.min(np.linalg.norm(a + t[:, None] * d - x, axis=1)))
+    X = a + t[:, None] * d
+    k = int(np.argmin(np.linalg.norm(X - x, axis=1)))
+    return X[k], float(np.linalg.norm(X[k] - x))
+
+
+def _distance_to_polyline(x: np.ndarray, P: np.ndarray) -> float:
+    """Distance from x to the polyline through the points P (scaled coordinates)."""
+    return nearest_on_polyline(x, P)[1]
 
 
 def _clip_to_box(p, c, tr: BoundaryTracer):

@@ -29,7 +29,7 @@ import numpy as np
 
 from ..results import pyplot, save_figure, write_json
 from ..structure.model import Model
-from .boundary import Curve, trace_boundaries
+from .boundary import Curve, nearest_on_polyline, trace_boundaries
 from .branch import Branch, continue_static
 from .equilibria import Equilibria
 from .maps import StabilityMap
@@ -198,15 +198,7 @@ def _junctions(polys: list[np.ndarray]) -> list[np.ndarray]:
             for j, Q in enumerate(polys):
                 if j == i or len(Q) == 0:
                     continue
-                if len(Q) == 1:
-                    x, d = Q[0], float(np.linalg.norm(Q[0] - e))
-                else:
-                    a, b = Q[:-1], Q[1:]
-                    t = np.clip(np.einsum("ij,ij->i", e - a, b - a) / np.maximum(np.einsum("ij,ij->i", b - a, b - a),
-                                                                                 1e-30), 0.0, 1.0)
-                    X = a + t[:, None] * (b - a)
-                    k = int(np.argmin(np.linalg.norm(X - e, axis=1)))
-                    x, d = X[k], float(np.linalg.norm(X[k] - e))
+                x, d = nearest_on_polyline(e, Q)
                 if 1e-12 < d < best:
                     best, where = d, x
             if where is not None:
