@@ -9,6 +9,8 @@ import numpy as np
 import pytest
 
 from rotorub_model.analyses.detection import (
+    CHORDS_M,
+    THETAS_DEG,
     closure,
     contact_map,
     linear_responses,
@@ -188,3 +190,14 @@ def test_cli_detect_bad_args(tmp_path, capsys):
     assert len(err) == 1 and "--n-g0" in err[0] and "[2, inf)" in err[0]
     assert main(["detect", "--out", str(tmp_path), "--g0-max-mm", "-2"]) == 2
     assert "g0_max" in capsys.readouterr().err
+
+
+def test_the_sweeps_hold_the_configurations_own_cone_and_chord(det):
+    """The paper's sweeps (theta 0-30 deg, chord 1-30 cm) plus the configuration's own values: a newcomer's 0.5 m
+    chord and 15 deg cone were not among the sweeps of its own detection study. The reference's are (5 deg, 20 cm)."""
+    from rotorub_model.structure.params import reference_parameters
+
+    assert det.thetas_deg == THETAS_DEG and det.chords_m == CHORDS_M
+    m = build_model(reference_parameters().replace(contact={"chord": 0.5, "theta_deg": 15.0}))
+    r = run_detection(m, n_speeds=40, n_g0=20, progress=False)
+    assert r.chords_m == (*CHORDS_M, 0.5) and 15.0 in r.thetas_deg and len(r.thetas_deg) == len(THETAS_DEG) + 1

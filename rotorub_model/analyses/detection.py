@@ -387,8 +387,8 @@ def run_detection(
     speed_min: float = 0.05,
     speed_max: float = 10.0,
     n_speeds: int = 400,
-    thetas_deg: tuple[float, ...] = THETAS_DEG,
-    chords: tuple[float, ...] = CHORDS_M,
+    thetas_deg: tuple[float, ...] | None = None,
+    chords: tuple[float, ...] | None = None,
     progress: bool = True,
 ) -> DetectionResult:
     """Detection study (all four): closures of 2D, 3D full, the degraded 3D variants and
@@ -399,8 +399,16 @@ def run_detection(
     imbalance response found in its range are always inserted exactly.
     ``g0_max`` [m]: top of the clearance grid of the boolean maps (default: 1.05 x the
     largest closure of all studies); the grid is n_g0 points on [0, g0_max].
+    ``thetas_deg``, ``chords``: the sweeps (default: the paper's, THETAS_DEG and CHORDS_M, with the configuration's
+    own cone angle and chord among them).
     """
     from tqdm import tqdm
+
+    own = model.params.contact
+    if thetas_deg is None:
+        thetas_deg = tuple(sorted({*THETAS_DEG, float(own.theta_deg)}))
+    if chords is None:
+        chords = tuple(sorted({*CHORDS_M, float(own.chord)}))
 
     if model.params.imbalance.me == 0.0:
         raise ParameterError("imbalance.me: 0 kg m; the detection maps put the imbalance response into the gaps "
