@@ -36,7 +36,8 @@ HERE = Path(__file__).resolve().parent
 
 
 def bare_library(tmp: Path) -> ctypes.CDLL:
-    out = compile_shared([HERE / "bare_loop.c"], tmp / f"bare_loop{host_suffix()}", include=[kernel.HERE])
+    out = compile_shared([HERE / "bare_loop.c", *kernel.SOURCES], tmp / f"bare_loop{host_suffix()}",
+                         include=[kernel.HERE])
     lib = ctypes.CDLL(str(out))
     dp = ctypes.c_void_p
     lib.bare_cd.argtypes = [ctypes.POINTER(kernel.RRContact), ctypes.POINTER(kernel.RRMatrices), dp, dp,

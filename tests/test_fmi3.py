@@ -143,14 +143,17 @@ def test_sources_binaries_and_the_same_model(unzipped3, native_fmu):
 
     src = unzipped3 / "sources"
     bd = (src / "buildDescription.xml").read_text()
-    for f in ("fmi3_cs.c", "fmu_core.c", "contact_model.c", "model_data.c", "rotorub_kernel.c"):
+    from rotorub_model import kernel
+
+    kernel_c = tuple(p.name for p in kernel.SOURCES)
+    for f in ("fmi3_cs.c", "fmu_core.c", "contact_model.c", "model_data.c", *kernel_c):
         assert f'<SourceFile name="{f}"/>' in bd and (src / f).is_file()
         assert f in (src / "CMakeLists.txt").read_text()
     so = unzipped3 / "binaries" / "x86_64-linux" / "RotorCasingContact.so"
     assert missing_fmi_functions(so, "3.0") == {"x86_64": []}
     assert newest_glibc(so) <= (2, 17)
     with zipfile.ZipFile(native_fmu) as z:  # one model: the FMI 2.0 FMU's files, byte for byte
-        for f in ("contact_model.c", "fmu_core.c", "fmu_model.h", "rotorub_kernel.c"):
+        for f in ("contact_model.c", "fmu_core.c", "fmu_model.h", *kernel_c):
             assert z.read(f"sources/{f}") == (src / f).read_bytes(), f
 
 

@@ -28,6 +28,8 @@ import tempfile
 import zipfile
 from pathlib import Path
 
+from rotorub_model import kernel
+
 from .. import interface
 from .native_compile import NativeBuildError, compile_platforms
 
@@ -35,7 +37,7 @@ HERE = Path(__file__).resolve().parent.parent  # fmu_src/
 NATIVE = HERE / "native"
 WRAPPER = ("fmi2_cs.c", "fmu_core.c", "fmu_core.h", "fmu_model.h")
 WRAPPER3 = ("fmi3_cs.c", "fmu_core.c", "fmu_core.h", "fmu_model.h", "fmi3_vars.h")
-C_SOURCES = ("fmi2_cs.c", "fmu_core.c", "contact_model.c", "model_data.c", "rotorub_kernel.c")
+C_SOURCES = ("fmi2_cs.c", "fmu_core.c", "contact_model.c", "model_data.c", *(p.name for p in kernel.SOURCES))
 FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 FMI3_HEADERS = ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")
 

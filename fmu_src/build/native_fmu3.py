@@ -33,6 +33,8 @@ from datetime import datetime, timezone
 from pathlib import Path
 from xml.etree.ElementTree import Element, SubElement
 
+from rotorub_model import kernel
+
 from .. import interface
 from .native_fmu import (
     FMI3_HEADERS,
@@ -47,7 +49,7 @@ from .native_fmu import (
     variable_table,
 )
 
-C_SOURCES3 = ("fmi3_cs.c", "fmu_core.c", "contact_model.c", "model_data.c", "rotorub_kernel.c")
+C_SOURCES3 = ("fmi3_cs.c", "fmu_core.c", "contact_model.c", "model_data.c", *(p.name for p in kernel.SOURCES))
 TYPE3 = {"Real": "Float64", "Integer": "Int32", "Enumeration": "Enumeration", "String": "String"}
 BLADE_ARRAY = re.compile(r"^blade\[(\d+)\]\.(\w+)$")
 HARMONIC = re.compile(r"^wear\.harmonic\[(\d+)\]$")
@@ -271,7 +273,6 @@ def build_native_fmu3(dest: str | Path = "fmus/native-fmi3", params_file: str | 
                       platforms: tuple[str, ...] | None = None, mode: str = "transient") -> dict:
     """Build ``dest/RotorCasingContact.fmu`` (FMI 3.0, native); returns a summary dict (as build_native_fmu)."""
     from rotorub_model import __version__ as lib_version
-    from rotorub_model import kernel
     from rotorub_model.structure.model import build_model
     from rotorub_model.structure.params import REFERENCE_FILE, load_parameters
 

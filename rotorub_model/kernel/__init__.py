@@ -1,4 +1,4 @@
-"""The compiled kernel (``rotorub_kernel.c``): loading it, and typed handles on its structs.
+"""The compiled kernel (``rr_*.c`` behind ``rotorub_kernel.h``): loading it, and typed handles on its structs.
 
 The shared library is found, in this order:
 
@@ -27,10 +27,13 @@ import numpy as np
 from .compiler import CFLAGS, CompilerError, compile_shared, host_platform_tag, host_suffix
 
 HERE = Path(__file__).resolve().parent
-SOURCES = (HERE / "rotorub_kernel.c",)
+# one concern a file (rr_internal.h lists them); the library, both FMUs and the benchmarks compile all of them
+SOURCES = tuple(HERE / f"rr_{name}.c" for name in ("core", "geometry", "laws", "contact", "liner", "cd", "linalg",
+                                                   "static"))
 HEADER = HERE / "rotorub_kernel.h"
+INTERNAL_HEADER = HERE / "rr_internal.h"  # declarations shared by the sources, exported by none
 MATH_HEADER = HERE / "rr_math.h"  # the elementary functions: the same bits on every platform
-HEADERS = (HEADER, MATH_HEADER)
+HEADERS = (HEADER, INTERNAL_HEADER, MATH_HEADER)
 ABI_VERSION = 7
 LAW_WIDTH = 7
 OUT_BLADE_BLOCKS = 6

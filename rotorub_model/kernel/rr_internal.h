@@ -1,0 +1,73 @@
+/*
+ * rotorub kernel, internal declarations shared by its source files (not part of the API: with
+ * -fvisibility=hidden nothing here is exported). The public header is rotorub_kernel.h.
+ *
+ * The kernel's files, one concern each:
+ *   rr_core.c      version, source id, scratch sizes, the elementary functions for tests
+ *   rr_geometry.c  the contact geometry of the 2D and 3D formulations (gap gradients, sliding rows)
+ *   rr_laws.c      the normal contact laws of one blade (point and chord laws)
+ *   rr_contact.c   gaps, friction, the generalised contact force and its Jacobians, outputs of a state
+ *   rr_liner.c     the casing surface: abradable liner, clearance closure, casing offset
+ *   rr_cd.c        explicit central differences (the time loop and its matrices)
+ *   rr_linalg.c    dense linear algebra: LU, inverse, eigenvalues
+ *   rr_static.c    balanced static solutions (Newton)
+ */
+#ifndef RR_INTERNAL_H
+#define RR_INTERNAL_H
+
+#include <math.h>
+#include <stddef.h>
+
+#include "rotorub_kernel.h"
+#include "rr_math.h" /* sin, cos, tan, atan2, tanh, sqrt: the same bits on every platform */
+
+/* rr_laws.c */
+void rri_chord_law(double g_le, double g_te, double k, double l, double *out);
+void rri_point_law(double g, double k, double *out);
+
+/* rr_contact.c */
+void rri_raw_gaps(const rr_contact *c, const double *q, double *gaps);
+void rri_gaps_of(const rr_contact *c, const double *q, double *gaps);
+void rri_laws_of(const rr_contact *c, const double *gaps, double *law);
+void rri_friction_of(const rr_contact *c, const double *law, double omega, const double *qdot, const double *q,
+                     const double *q_prev, double dt, double *fr);
+void rri_outputs_from_law(const rr_contact *c, const double *q, const double *gaps, const double *law,
+                          const double *fr, double phi, const int *index, double *dest);
+
+/* rr_cd.c: one central-difference step from the laws and friction factors already evaluated at q */
+void rri_cd_update(int n, int nb, int np, double l, const double *restrict law, const double *restrict fr,
+                   const double *restrict A, const double *restrict B, const double *restrict S,
+                   const double *restrict Ainv, const double *restrict K2, const double *restrict Cm1,
+                   const double *restrict f, const double *restrict f0, double r, double *restrict q,
+                   double *restrict qp, double *restrict rhs);
+
+/* rr_liner.c */
+void rri_surface_apply(const rr_contact *c, double *gaps);
+void rri_surface_cut(const rr_contact *c, const double *gaps, double phi_new);
+double rri_liner_law(double g, double k, double fy, double h, double thickness, int wears, double *depth,
+                     double *work);
+
+/* small and on the hot path: inline in every file */
+/* Share of the blade's normal force carried by each contact point: the pressure p(c) >= 0 on
+ * [-l/2, l/2] is statically equivalent to w_LE = F/2 - M/l at the LE and w_TE = F/2 + M/l at
+ * the TE (both >= 0); dw/dF and dw/dM are (1/2, -1/l) and (1/2, 1/l). 2D: w = F_N. */
+static inline void rri_point_weights(int np, double l, double FN, double MN, double *w, double *aF, double *aM)
+{
+    if (np == 2) {
+        w[0] = 0.5 * FN - MN / l;
+        w[1] = 0.5 * FN + MN / l;
+        aF[0] = 0.5;
+        aF[1] = 0.5;
+        aM[0] = -1.0 / l;
+        aM[1] = 1.0 / l;
+    } else {
+        w[0] = FN;
+        aF[0] = 1.0;
+        aM[0] = 0.0;
+    }
+}
+
+/* (e_z x r).e_t: the sliding speed of the point per unit spin (its radius for e_t = e_theta) */
+static inline double rri_spin_arm(const double *P, const double *t) { return P[0] * t[1] - P[1] * t[0]; }
+
+#endif
