@@ -203,5 +203,5 @@ def test_slip_velocity_parameter(model):
     c = make_contact(model, "2D", slip_velocity=0.5)
     assert c.v_slip == 0.5
     assert make_contact(model, "2D").v_slip == model.params.contact.slip_velocity == 0.1
-    with pytest.raises(ParameterError, match=r"contact\.slip_velocity.*\(0, 10\]"):
+    with pytest.raises(ParameterError, match=r"contact\.slip_velocity.*\[0.0001, 10\]"):
         model.params.replace(contact={"slip_velocity": 0.0})

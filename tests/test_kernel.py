@@ -84,9 +84,10 @@ def test_ziglang_alone_builds_a_kernel_that_gives_the_same_numbers(monkeypatch, 
 
     lib = ctypes.CDLL(str(out))
     args = [ctypes.c_double(v) for v in (-1e-3, 2e-4, 1.5e6, 0.2)]
-    res = (ctypes.c_double * 7)()
-    lib.rr_blade_law(2, *args, res)
-    assert tuple(res) == kernel.chord_law(-1e-3, 2e-4, 1.5e6, 0.2)
+    law = kernel.make_law("bilinear", (0.3e-3, 4.0))
+    res = (ctypes.c_double * kernel.LAW_WIDTH)()
+    lib.rr_blade_law(ctypes.byref(law), 2, *args, res)
+    assert tuple(res) == kernel.blade_law(-1e-3, 2e-4, 1.5e6, 0.2, law)
 
 
 def test_eigenvalues_converge_where_the_classic_hqr_stopped(ref_model):

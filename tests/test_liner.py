@@ -144,8 +144,11 @@ def test_removed_volume_and_plastic_work_are_the_profiles(offset_run, model):
 
 
 def test_volume_and_work_converge_with_the_cells(model):
-    """The offset casing's wear with 360, 1440 and 2880 cells: volume and plastic work converge (measured:
-    1.1 % from 360 to 2880 cells, 0.014 % from 1440), so the work is the liner's, not its discretisation's."""
+    """The offset casing's wear with 360, 1440 and 2880 cells: volume and plastic work converge, so the work is
+    the liner's, not its discretisation's. The offset is there at t = 0, with every blade's cell in its way cut at
+    once (the exact return map, before the rotor is pushed away): one cell per blade deeper than the rest of the
+    arc, a volume of order 1 / cells, so the convergence is first order (measured: 0.86 % from 360 to 2880 cells,
+    0.113 % from 1440; the ratio 0.132 against first order's 0.143)."""
     out = {}
     for ns in (360, 1440, 2880):
         c = make_contact(model, "2D", g0=0.2e-3)
@@ -153,10 +156,11 @@ def test_volume_and_work_converge_with_the_cells(model):
         run_transient(model, c, 0.5 * model.params.normalisation.omega_ref, t_end=1.0, me=0.0, t_ramp=0.0,
                       liner=liner)
         out[ns] = liner.summary()
+    first_order = (1 / 1440 - 1 / 2880) / (1 / 360 - 1 / 2880)
     for key in ("volume", "plastic_work"):
         coarse, fine, finest = (out[ns][key] for ns in (360, 1440, 2880))
-        assert abs(fine - finest) < 1e-3 * finest and abs(coarse - finest) < 2e-2 * finest
-        assert abs(fine - finest) < 0.1 * abs(coarse - finest)
+        assert abs(coarse - finest) < 2e-2 * finest and abs(fine - finest) < 2e-3 * finest
+        assert abs(fine - finest) == pytest.approx(first_order * abs(coarse - finest), rel=0.15)
 
 
 def _stationary_backward_wave(model, h):
@@ -264,3 +268,113 @@ def test_the_wear_command_writes_its_figures_and_refuses_bad_inputs(tmp_path, ca
     assert main(["wear", "--closure", "0.5", "--out", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err
     assert "--closure" in err and "[-0.01, 0.01] m" in err
+
+
+# --------------------------------------------------------------------------- the engine's inputs changing mid-run
+@pytest.mark.parametrize("formulation", ["2D", "3D"])
+def test_a_jump_while_cutting_keeps_the_force_and_cuts_exactly_the_jump(formulation):
+    """A blade cutting the liner at rest (Omega = 0) while the engine pushes the casing into it (the offset grows
+    by 2 um a millisecond), and the same run with the offset jumping 10 um more at one communication point: the
+    exact return map cuts the jump away before the first force, so the force stays at the yield bound and the
+    structure does not move differently (below 1e-9 m), and the blade's cell is cut deeper by exactly the jump
+    seen along the normal (within 0.1 %). Three blades, so that the blade that cuts is the only one touching (the
+    others, 120 deg away, stay open). Before the map saw the new surface, the first step's force was the uncapped
+    elastic one: 1.8 um of motion, a cut 10.11 um deep for a 10 um jump."""
+    m = build_model(reference_parameters().replace(blades={"count": 3}))
+    c = make_contact(m, formulation, g0=0.1e-3)
+    jump = 10e-6
+    runs = []
+    for with_jump in (False, True):
+        liner = Liner.for_model(m, c, wears=True, thickness=5e-3)
+        state, q = None, []
+        for k in range(60):
+            e = 0.16e-3 + 2e-6 * k + (jump if with_jump and k >= 40 else 0.0)
+            liner.set_inputs(offset=(-e, 0.0))  # towards -x: closes the gap of the blade at alpha = 0
+            if k == 40:
+                before = liner.depth.copy()
+            r = run_transient(m, c, 0.0, t_end=1e-3, me=0.0, t_ramp=0.0, liner=liner, start=state)
+            state = r.final_state
+            if k == 40:
+                after = liner.depth.copy()
+            if k >= 40:
+                q.append(r.q)
+        runs.append((np.vstack(q), before, after, liner, r))
+    (q0, b0, a0, _, r0), (q1, b1, a1, liner, r1) = runs
+    assert np.array_equal(b0, b1) and 0.99 * FY < r0.outputs["F_N"][-1, 0] <= FY * (1 + 1e-12), "cutting"
+    assert (r0.outputs["F_N"][-1, 1:] == 0).all(), "the other blades stay open"
+    assert np.abs(q1 - q0).max() < 1e-9
+    extra = (a1 - b1) - (a0 - b0)  # what the jump cut, on top of the ramp's own increment
+    cut = extra > 0
+    nr = np.hypot(*c.geometry.normals[0, :, :2].T)  # the cutting points' normals' radial parts
+    expected = jump * nr[:, None] * np.cos(liner.angles)[None, :]
+    assert cut.sum() == c.n_points  # one cell per point of the one blade
+    np.testing.assert_allclose(extra[cut], expected[cut], rtol=1e-3)
+    np.testing.assert_allclose(r1.outputs["F_N"][:, 0], r0.outputs["F_N"][:, 0], rtol=1e-9)
+
+
+def test_a_continued_run_meets_the_liner_where_it_left_it(model):
+    """Two runs of 0.5 s, the second going on from the first's final state (frame angle, both states, the worn
+    profile), are one run of 1 s, to round-off (the frame angle is summed in two parts): the rotor meets the worn
+    liner at the angle it left it. (A second run that restarted the angle at 0 met cells cut by another blade: 12
+    cells cut up to 13.7 um deeper in two steps.)"""
+    w = 1.0 * model.params.normalisation.omega_ref
+    c = make_contact(model, "2D", g0=0.2e-3)
+    one = Liner.for_model(model, c, wears=True, offset=(0.3e-3, 0.0))
+    r1 = run_transient(model, c, w, t_end=1.0, me=0.0, t_ramp=0.0, liner=one)
+    two = Liner.for_model(model, c, wears=True, offset=(0.3e-3, 0.0))
+    a = run_transient(model, c, w, t_end=0.5, me=0.0, t_ramp=0.0, liner=two)
+    b = run_transient(model, c, w, t_end=0.5, me=0.0, t_ramp=0.0, liner=two, start=a.final_state)
+    assert b.final_state.phi == pytest.approx(w * 1.0, rel=1e-12) and b.t[0] > 0.5
+    np.testing.assert_allclose(np.vstack([a.q, b.q]), r1.q, rtol=0, atol=1e-10 * np.abs(r1.q).max())
+    np.testing.assert_allclose(two.depth, one.depth, rtol=0, atol=1e-10 * one.depth.max())
+    assert one.depth.max() > 0
+    with pytest.raises(ParameterError, match="start: the previous run had a liner"):
+        run_transient(model, c, w, t_end=0.1, start=a.final_state)
+
+
+# --------------------------------------------------------------------------- the casing out of round
+def test_an_oval_casing_opens_and_closes_the_gaps_where_its_lobes_are(model):
+    """A rigid surface with lobes n = 2 and 3: every point's gap is the round casing's plus n_r sum_n a_n
+    cos(n (alpha + phi - psi_n)), at any frame angle (the kernel's tables against the closed form)."""
+    import ctypes
+
+    for formulation in ("2D", "3D"):
+        c = make_contact(model, formulation, g0=1e-3)
+        liner = Liner.for_model(model, c, wears=False, distortion={2: (0.2e-3, 0.3), 3: (-0.05e-3, 1.1)})
+        seen = liner.attach(c.kernel)
+        q = 1e-5 * np.random.default_rng(2).standard_normal(model.n_dofs)
+        g = c.geometry
+        alpha = np.arctan2(g.points[..., 1], g.points[..., 0])
+        nr = np.hypot(g.normals[..., 0], g.normals[..., 1])
+        for phi in (0.0, 0.7, 5.9, 40.1):
+            liner.struct.phi = phi
+            out = np.empty((c.n_blades, c.n_points))
+            c.lib.rr_gaps_batch(ctypes.byref(seen), 1, kernel.ptr(np.ascontiguousarray(q)), kernel.ptr(out))
+            exact = c.gaps(q) + nr * (0.2e-3 * np.cos(2 * (alpha + phi - 0.3))
+                                      - 0.05e-3 * np.cos(3 * (alpha + phi - 1.1)))
+            np.testing.assert_allclose(out, exact, atol=1e-15)
+    for bad in ({1: (1e-4, 0.0)}, {9: (1e-4, 0.0)}, {2: (np.nan, 0.0)}, {2: 1e-4}):
+        with pytest.raises(ParameterError, match="casing distortion"):
+            Liner.for_model(model, c, wears=False, distortion=bad)
+
+
+@pytest.mark.parametrize("speed", [0.5, 2.0])
+def test_an_oval_casing_wears_two_lobes(model, speed):
+    """A rotor spinning centred in an oval casing that closes the clearance at psi +- pi/2: the liner wears at
+    the two tight places and nowhere else, to the rigid closed form -(g0 + a cos 2(theta - psi)) - F_y / k_r where
+    positive, and the lobe rule reads 2. (At 0.5 and 2 Omega_ref: 2 % and 1e-15 over the closed form. At 1
+    Omega_ref the blade passing, 10 Omega = 85 Hz, rings the ring's n = 2 mode, 74 Hz: 9 % over it, and a few
+    cells worn within 0.6 deg outside the arc.)"""
+    c = make_contact(model, "2D", g0=0.1e-3)
+    psi, a = 0.4, 0.2e-3  # a > 0 opens the gap at psi: the tight places are psi +- pi/2
+    liner = Liner.for_model(model, c, wears=True, distortion={2: (a, psi)})
+    run_transient(model, c, speed * model.params.normalisation.omega_ref, t_end=1.0, me=0.0, t_ramp=0.0,
+                  liner=liner)
+    th = liner.angles
+    exact = np.clip(-(0.1e-3 + a * np.cos(2 * (th - psi))) - FY / K, 0.0, None)
+    prof = liner.profile
+    assert prof.max() == pytest.approx(exact.max(), rel=0.03)
+    assert np.all(prof[exact == 0] == 0.0)
+    assert np.all(prof <= exact + 0.03 * exact.max())
+    s = liner.summary()
+    assert s["lobes"] == 2 and s["harmonic_2"] > 5 * max(s["harmonic_1"], s["harmonic_3"])

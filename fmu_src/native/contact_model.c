@@ -24,7 +24,7 @@ struct model_runtime {
     int formulation, mode, n, nb, np;
     double g0, k_r, mu, theta, chord, dt_max, max_pen, v_slip;
     rr_geometry geo;
-    double *geo_mem, *cwork;
+    double *geo_mem, *cwork, *cache;
     rr_contact contact;
     /* transient */
     double *q, *qp;
@@ -67,40 +67,12 @@ void model_free(model_runtime *m)
     free(m);
 }
 
-/* K(Omega) = K + Omega^2 (S2 + N2) + Omega C1, in the library's order of operations */
-static void k_omega(const model_data *d, double w, double *out)
-{
-    size_t i, nn = (size_t)d->n * d->n;
-    double ww = w * w;
-    for (i = 0; i < nn; ++i) out[i] = d->K[i] + ww * (d->S2[i] + d->N2[i]) + w * d->C1[i];
-}
-
-/* 2 / sqrt(max |eig(M^-1 (K(w) + Kc))|), Kc the contact stiffness with every blade in full contact */
+/* K(Omega) and the explicit step limit are the kernel's (rr_k_omega, rr_critical_step): the library calls the same */
 static double critical_step(model_runtime *m, double w)
 {
     const model_data *d = &MODEL_DATA;
-    int n = m->n, i, j, k;
-    size_t nn = (size_t)n * n;
-    double *Kc = m->Kw, *P = m->Aeig, *J = m->swork, *zero = m->Fw, big = 0.0;
-    rr_contact closed = m->contact;
-    closed.g0 = -1.0;
-    closed.surface = NULL; /* every blade closed: the surface changes nothing the limit sees */
-    for (i = 0; i < n; ++i) zero[i] = 0.0;
-    rr_jacobian(&closed, zero, NULL, w, J, NULL);
-    k_omega(d, w, Kc);
-    for (i = 0; i < (int)nn; ++i) Kc[i] = Kc[i] + -J[i];
-    for (i = 0; i < n; ++i)
-        for (j = 0; j < n; ++j) {
-            double s = 0.0;
-            for (k = 0; k < n; ++k) s += m->Minv[(size_t)i * n + k] * Kc[(size_t)k * n + j];
-            P[(size_t)i * n + j] = s;
-        }
-    if (rr_eigenvalues(n, P, m->wr, m->wi, m->ework) != 0) return -1.0;
-    for (i = 0; i < n; ++i) {
-        double a = rr_sqrt(m->wr[i] * m->wr[i] + m->wi[i] * m->wi[i]);
-        if (a > big) big = a;
-    }
-    return 2.0 / rr_sqrt(big);
+    rr_k_omega(m->n, d->K, d->S2, d->N2, d->C1, w, m->Kw);
+    return rr_critical_step(&m->contact, w, m->Minv, m->Kw, m->Aeig); /* Aeig: 4 n^2 of scratch */
 }
 
 model_runtime *model_configure(const model_values *v, double t0, char *msg, size_t len)
@@ -140,7 +112,8 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
 
     /* contact geometry (the kernel's, from the ingredients baked at build time) */
     m->geo_mem = (double *)zalloc((size_t)nb * P * (3 * 3 + 2 * 3 * n) + 2 * (size_t)nb * P * n +
-                                      2 * (size_t)nb * n + 2 * (size_t)n + (size_t)rr_work_size(n, nb, np),
+                                      2 * (size_t)nb * n + 2 * (size_t)n + (size_t)rr_work_size(n, nb, np) +
+                                      (size_t)rr_cd_cache_size(n, nb, np),
                                   sizeof(double));
     if (!m->geo_mem) goto oom;
     g = m->geo_mem;
@@ -156,6 +129,7 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
     TAKE(m->geo.S, (size_t)nb * P * n);
     TAKE(m->geo.T2, 2 * (size_t)n);
     TAKE(m->cwork, (size_t)rr_work_size(n, nb, np));
+    TAKE(m->cache, (size_t)rr_cd_cache_size(n, nb, np));
 #undef TAKE
     spec.n = n;
     spec.nb = nb;
@@ -246,6 +220,10 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
     m->job.rec_every = 1;
     m->job.rec_cap = 0;
     m->job.out_index = OUTPUT_INDEX;
+    /* the contact evaluation of a step's last state is kept for the next step (the kernel checks it is that
+     * state at those inputs): a communication step costs its substeps, not one evaluation more */
+    m->job.cache = m->cache;
+    m->job.cache_valid = 0;
     /* the casing's surface: the liner (worn or rigid) and the engine's closure and offset, read at every step */
     {
         int ns = v->i[VR_N_SECTORS];
@@ -430,7 +408,7 @@ static model_status static_solution(model_runtime *m, model_values *v, double w,
     double rel, gmin, max_real = -HUGE_VAL;
     double *q = m->Ainv; /* the transient buffers are free in this mode: the candidate solution */
     double *J = m->K2, *A = m->Aeig, *C = m->Cm1;
-    k_omega(d, w, m->Kw);
+    rr_k_omega(m->n, d->K, d->S2, d->N2, d->C1, w, m->Kw);
     for (i = 0; i < n; ++i) m->Fw[i] = me * w * w * d->f_unit[i];
     m->contact.g0 = m->g0 - v->r[VR_CLOSURE]; /* the engine's closure: uniform, so a balanced solution still is */
     ok = rr_static_solve(&m->contact, w, m->Kw, m->Fw, m->have_qs ? m->qs : NULL, 1e-10, 60, q, &rel, &its, m->swork,

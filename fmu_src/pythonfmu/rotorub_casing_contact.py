@@ -600,7 +600,8 @@ class RotorCasingContact(Fmi2Slave):
             if "cd" in sim:
                 t, steps, phi, q, q_prev, div, dt, g0, ls = sim["cd"].get_state()
                 s["cd"] = {"t": t, "steps": steps, "phi": phi, "q": q, "q_prev": q_prev, "diverged": div,
-                           "dt": dt, "g0": g0, "liner": {"depth": ls[0], "phi": ls[1], "plastic_work": ls[2]}}
+                           "dt": dt, "g0": g0, "liner": {"depth": ls[0], "phi": ls[1], "plastic_work": ls[2],
+                                                         "cut_inputs": list(ls[6])}}
             state["sim"] = s
         return state
 
@@ -650,6 +651,8 @@ class RotorCasingContact(Fmi2Slave):
                     raise ValueError(f"liner depths are not {cells} finite values >= 0")
                 if not (math.isfinite(float(ls["phi"])) and float(ls["plastic_work"]) >= 0):
                     raise ValueError("liner angle or plastic work invalid")
+                if len(ls["cut_inputs"]) != 3 + 2 * (self._lib.kernel.MAX_LOBES + 1):
+                    raise ValueError("liner inputs last cut at: wrong count")
 
     def _restore(self, state) -> None:
         rv, iv = np.asarray(state["rv"], dtype=float), np.asarray(state["iv"], dtype=np.int64)
@@ -680,7 +683,8 @@ class RotorCasingContact(Fmi2Slave):
             sim["cd"].set_state((c["t"], c["steps"], c["phi"], np.asarray(c["q"], dtype=float),
                                  np.asarray(c["q_prev"], dtype=float), c["diverged"], c["dt"], c["g0"],
                                  (np.asarray(ls["depth"], dtype=float), float(ls["phi"]), float(ls["plastic_work"]),
-                                  liner.closure, liner.offset)))
+                                  liner.closure, liner.offset, liner.distortion,
+                                  [float(v) for v in ls["cut_inputs"]])))
             self._write_wear(fresh=True)
         if s["g0"] != sim["g0"]:
             sim["g0"] = s["g0"]

@@ -5,8 +5,8 @@ mechanical energy
 
     E = 1/2 q'^T M q' + 1/2 q^T K(Omega) q + V_c(q)
 
-(K(Omega) symmetric: the gyroscopic matrix does no work; V_c the penalty energy of the normal
-contact pressure, (k_r / l_c) int 1/2 gap(c)^2 over the penetrated chord, 1/2 k_r gap^2 in 2D)
+(K(Omega) symmetric: the gyroscopic matrix does no work; V_c the strain energy of the normal law,
+the kernel's: for the penalty law (k_r / l_c) int 1/2 gap(c)^2 over the penetrated chord, 1/2 k_r gap^2 in 2D)
 changes only by the friction's power. The drive that holds Omega constant feeds the power
 P_drive = -Omega tau_z (tau_z: the contact torque on the rotor about the spin axis), and the
 friction dissipates sum_p mu tanh(v_p / v_slip) w_p v_p >= 0, so
@@ -29,33 +29,15 @@ from ..structure.model import Model
 
 
 def contact_potential(contact: ContactModel, Q: np.ndarray) -> np.ndarray:
-    """Penalty energy of the normal contact pressure of states Q (m, n) [J]: its gradient is
-    -F_nl without friction (Simpson's rule is exact for the quadratic integrand)."""
-    return contact_potential_of_gaps(contact, contact.gaps_batch(np.atleast_2d(Q)))
+    """The normal law's strain energy of states Q (m, n) [J] (the kernel's, for every law): its gradient is
+    -F_nl without friction."""
+    return contact.potential(np.atleast_2d(Q))
 
 
 def contact_potential_of_gaps(contact: ContactModel, g: np.ndarray) -> np.ndarray:
     """The same from the states' gaps (m, N, P): what a run against a worn liner records (its outputs' gaps
     are to the worn surface, which the model's own gaps(q) do not know)."""
-    g = np.asarray(g, dtype=float)
-    if contact.n_points == 1:
-        return 0.5 * contact.k_r * np.sum(np.minimum(g[..., 0], 0.0) ** 2, axis=1)
-    l = contact.geometry.chord
-    gle, gte = g[..., 0], g[..., 1]
-    h = 0.5 * l
-    eta, zeta = 0.5 * (gle + gte), (gte - gle) / l
-    with np.errstate(divide="ignore", invalid="ignore"):
-        front = np.where(zeta != 0.0, -eta / np.where(zeta != 0.0, zeta, 1.0), 0.0)
-    c1 = np.where(gle < 0.0, -h, np.clip(front, -h, h))
-    c2 = np.where(gte < 0.0, h, np.clip(front, -h, h))
-    touching = (gle < 0.0) | (gte < 0.0)
-    c1, c2 = np.where(touching, c1, 0.0), np.where(touching, c2, 0.0)
-
-    def half_sq(c):
-        return 0.5 * np.minimum(eta + zeta * c, 0.0) ** 2
-
-    integral = (c2 - c1) / 6.0 * (half_sq(c1) + 4.0 * half_sq(0.5 * (c1 + c2)) + half_sq(c2))
-    return contact.k_r / l * np.sum(integral, axis=1)
+    return contact.potential_of_gaps(g)
 
 
 @dataclass

@@ -70,7 +70,8 @@ class ContactSetStarts:
             one = dataclasses.replace(g, points=g.points[j:j + 1], normals=g.normals[j:j + 1],
                                       tangents=g.tangents[j:j + 1], Jb=g.Jb[j:j + 1], Jc=g.Jc[j:j + 1],
                                       G=g.G[rows], A=g.A[j:j + 1], B=g.B[j:j + 1], S=g.S[rows])
-            # g0 = -1 closes the blade at q = 0, where its force is -h
+            # g0 = -1 closes the blade at q = 0, where its force is -h; the law's first slope (the penalty's: a
+            # bilinear law's knee makes the set's law affine only up to it, so its sets are Newton starts only)
             c = ContactModel(base.formulation, base.variant, one, -1.0, base.k_r, base.mu, base.v_slip)
             J.append(c.jacobian(z, omega))
             h.append(-c.forces(z, omega))
@@ -126,7 +127,9 @@ class ContactSetStarts:
         """(equilibrium or None, proven_absent) at clearance g0; of several, the one nearest ``near``."""
         c = self.base.with_clearance(g0)
         qs, ok, violation, _ = self.solve(self.arcs(), g0)
-        piecewise_affine = self.base.formulation == "2D"
+        # the 2D point law is affine on each side of first contact: a consistent set is an exact equilibrium, and
+        # none consistent of all 2^N proves there is none; not so past a bilinear law's knee
+        piecewise_affine = self.base.formulation == "2D" and self.base.law == "penalty"
         if piecewise_affine and ok.any():
             return self._polish(c, self._nearest(qs[ok], near)), False
         for k in np.argsort(violation)[:NEWTON_STARTS]:

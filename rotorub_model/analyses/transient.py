@@ -48,15 +48,21 @@ from ..structure.model import Model
 
 
 def all_closed_stiffness(contact: ContactModel, omega: float) -> np.ndarray:
-    """Contact stiffness with every blade in full contact (-dF_nl/dq) at spin omega."""
-    return -contact.with_clearance(-1.0).jacobian(np.zeros(contact.n_dofs), omega)
+    """Contact stiffness with every blade in full contact at the law's largest slope (-dF_nl/dq) at spin omega."""
+    return contact.closed_stiffness(omega)
 
 
 def critical_time_step(model: Model, contact: ContactModel, omega: float) -> float:
-    """2 / w_max of the linearised system with all contacts closed [s]."""
-    Kc = model.K_omega(omega) + all_closed_stiffness(contact, omega)
-    lam = kernel.eigenvalues(kernel.inverse(model.M) @ Kc)  # the FMUs' eigen-solver, so all pick the same step
-    return 2.0 / math.sqrt(float(np.max(np.abs(lam))))
+    """2 / w_max of the linearised system with all contacts closed at the law's largest slope [s]: the kernel's
+    (rr_critical_step), which both FMUs call too, so all pick the same step."""
+    n = model.n_dofs
+    Minv = kernel.inverse(model.M)  # the kernel's LU, as the FMUs invert M
+    Kw = np.ascontiguousarray(model.K_omega(omega))
+    work = np.empty(contact.lib.rr_critical_step_work_size(n))
+    dt = contact.lib.rr_critical_step(contact.kernel, float(omega), kernel.ptr(Minv), kernel.ptr(Kw), kernel.ptr(work))
+    if not dt > 0:
+        raise ParameterError("the central-difference stability limit: the eigenvalue iteration did not converge")
+    return float(dt)
 
 
 class CentralDifference:
@@ -91,8 +97,11 @@ class CentralDifference:
         self.q_prev = np.zeros(n)
         self._s = kernel.RRState(0.0, self._check_dt(dt, self.dt_limit), 0.0, float(max_penetration), 0, 0,
                                  kernel.ptr(self.q), kernel.ptr(self.q_prev))
-        # one kernel job, kept: a call only changes what differs from the last one
+        # one kernel job, kept: a call only changes what differs from the last one; the job keeps the contact
+        # evaluation of its last state, so that a run cut into calls (held inputs) evaluates each state once
         self._job = kernel.RRJob(state=ctypes.addressof(self._s), t_ramp=float(t_ramp))
+        self._cache = np.zeros(contact.lib.rr_cd_cache_size(n, contact.n_blades, contact.n_points))
+        self._job.cache = kernel.ptr(self._cache)
         self._job_ref = ctypes.byref(self._job)
         self._bound: tuple = ()
         self._addresses: dict[int, tuple[np.ndarray, int]] = {}
@@ -118,6 +127,7 @@ class CentralDifference:
     def contact(self, c: ContactModel) -> None:
         self._contact = c
         self._run = c.lib.rr_cd_run
+        self._job.cache_valid = 0  # another contact struct: the kept evaluation is not its
         if self.liner is None:
             self._job.contact = ctypes.addressof(c.kernel)
         else:  # the loop's own view of the contact, with the liner's surface (the model's own stays rigid)
@@ -137,6 +147,7 @@ class CentralDifference:
         self._liner_on = bool(on)
         if self.liner is not None:
             self._job.contact = ctypes.addressof(self._seen if on else self._contact.kernel)
+            self._job.cache_valid = 0
 
     @staticmethod
     def _check_dt(dt: float | None, limit: float) -> float:
@@ -316,6 +327,25 @@ def outputs_from_q(model: Model, contact: ContactModel, q: np.ndarray, phi: np.n
     }
 
 
+@dataclass(frozen=True)
+class TransientState:
+    """Where a run stopped, for the next run to go on from (``run_transient(..., start=state)``): the time, the
+    scheme's two states, the frame angle (the rotor's angle against the casing: a worn liner is met where it was
+    left), the step, and the liner's state when it had one (its worn profile, inputs and last cut)."""
+
+    t: float  # [s]
+    q: np.ndarray  # (n) displacements at t
+    q_prev: np.ndarray  # (n) displacements at t - dt
+    phi: float  # [rad] frame angle at t
+    steps: int
+    dt: float  # [s] the step that produced q from q_prev
+    liner: tuple | None = None  # Liner.get_state()
+
+    @property
+    def velocity(self) -> np.ndarray:
+        return (self.q - self.q_prev) / self.dt
+
+
 @dataclass
 class TransientResult:
     formulation: str
@@ -330,6 +360,7 @@ class TransientResult:
     message: str
     omega_ref: float
     wear: dict | None = None  # with a liner: t, angles, profiles (nt, n_sectors), depth (rows), summary
+    final_state: TransientState | None = None  # where the run stopped: the next run's ``start``
 
     def blades_in_contact(self, i: int = -1) -> int:
         return int(np.sum(self.outputs["F_N"][i] > 0))
@@ -391,6 +422,7 @@ def run_transient(
     hold: float | None = None,
     liner: Liner | None = None,
     wear_record_dt: float = 0.05,
+    start: TransientState | None = None,
 ) -> TransientResult:
     """Central-difference transient from rest (or q0, v0), imbalance ramped over t_ramp.
 
@@ -406,6 +438,11 @@ def run_transient(
     ``liner`` (contact/liner.py): the casing's abradable liner, cut as the run goes (its state is the
     liner's: a second run goes on from the profile the first left); its profile is recorded every
     ``wear_record_dt`` seconds into ``result.wear``.
+
+    ``start``: a previous run's ``final_state``: this run goes on from it (time, both states, the frame angle,
+    the liner's worn profile; the engine's inputs are the liner's own, set on it between runs), for ``t_end``
+    more seconds; the imbalance ramp and a spin-speed history
+    read the continued time. Without it the run starts from rest at t = 0 (or from ``q0``, ``v0``).
     """
     for name, v, lo in (("t_end", t_end, 0.0), ("record_dt", record_dt, 0.0), ("segment", segment, 0.0)):
         if not math.isfinite(v) or v <= lo:
@@ -442,6 +479,23 @@ def run_transient(
     if q0 is not None:
         integ.q[:] = q0
         integ.q_prev[:] = q0 - (dt_ * v0 if v0 is not None else 0.0)
+    if start is not None:
+        if q0 is not None or v0 is not None:
+            raise ParameterError("start: a run goes on from a previous run's final state or from q0, v0, not both")
+        if not isinstance(start, TransientState) or np.shape(start.q) != (model.n_dofs,):
+            raise ParameterError(f"start: expected a TransientState of this model ({model.n_dofs} dofs)")
+        if (start.liner is None) != (liner is None):
+            raise ParameterError("start: the previous run " + ("had a liner: pass it (liner=...) to go on"
+                                                              if liner is None else "had no liner; this one has"))
+        integ.t, integ.steps, integ.phi = start.t, start.steps, start.phi
+        integ.q[:] = start.q
+        # the scheme's velocity carries over; the step may differ (another speed's limit): q_prev = q - dt v
+        integ.q_prev[:] = start.q - dt_ * start.velocity
+        if liner is not None:  # what the rub left; the engine's inputs stay the liner's own (set between runs)
+            inputs = (liner.closure, liner.offset, dict(liner.distortion))
+            liner.set_state(start.liner)
+            liner.set_inputs(*inputs)
+    t0 = integ.t
     n_total = int(round(t_end / dt_))
     rec_every = max(1, int(round(record_dt / dt_)))
     n_rec = n_total // rec_every
@@ -484,18 +538,20 @@ def run_transient(
             break
     if bar is not None:
         bar.close()
-    t_rec = (np.arange(written) + 1) * rec_every * dt_
+    t_rec = t0 + (np.arange(written) + 1) * rec_every * dt_
     q_rec = rec_q[:written]
     if constant:
         om = np.full(written, float(omega))
     else:  # with hold: the speed held over the interval that ends at the record
         om = np.array([omega_fn(t - hold if hold is not None else t) for t in t_rec])
+    phi0 = 0.0 if start is None else start.phi
     if hold is not None:
         phi = np.array(phi_rec[:written])  # the held intervals' angles, recorded as the run went
     elif constant or written == 0:
-        phi = om * t_rec
+        phi = phi0 + om * (t_rec - t0)
     else:  # frame angle: trapezoidal integral of the spin-speed history
-        phi = om[0] * t_rec[0] + np.concatenate([[0.0], np.cumsum(0.5 * (om[1:] + om[:-1]) * np.diff(t_rec))])
+        phi = phi0 + om[0] * (t_rec[0] - t0) + np.concatenate(
+            [[0.0], np.cumsum(0.5 * (om[1:] + om[:-1]) * np.diff(t_rec))])
     outs = outputs_from_q(model, integ.contact, q_rec, phi, rotating=rec_out[:written])
     msg = (
         f"diverged at t = {integ.t:.4f} s: penetration beyond {integ.max_penetration * 1e3:g} mm"
@@ -506,7 +562,9 @@ def run_transient(
     if liner is not None:
         k = integ.wear_records
         integ.record_wear(0, None)
-        wear = {"t": (np.arange(k) + 1) * wear_every * dt_, "angles": liner.angles, "profiles": wear_rows[:k].copy(),
-                "depth": liner.depth.copy(), "summary": liner.summary()}
+        wear = {"t": t0 + (np.arange(k) + 1) * wear_every * dt_, "angles": liner.angles,
+                "profiles": wear_rows[:k].copy(), "depth": liner.depth.copy(), "summary": liner.summary()}
+    final = TransientState(integ.t, integ.q.copy(), integ.q_prev.copy(), integ.phi, integ.steps, dt_,
+                           None if liner is None else liner.get_state())
     return TransientResult(contact.formulation, t_rec, q_rec, om, outs, dt_, integ.dt_limit, integ.diverged,
-                           integ.t, msg, model.params.normalisation.omega_ref, wear)
+                           integ.t, msg, model.params.normalisation.omega_ref, wear, final)

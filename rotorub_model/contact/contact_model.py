@@ -47,6 +47,7 @@ from ..errors import ParameterError
 from ..structure.model import Model
 from .chord3d import geometry_3d
 from .geometry import ContactGeometry
+from .laws import law_record
 from .point2d import geometry_2d
 
 FORMULATIONS = ("2D", "3D")
@@ -73,6 +74,8 @@ class ContactModel:
     k_r: float
     mu: float
     v_slip: float = 0.1
+    law: str = "penalty"  # contact/laws.py: the normal law and its parameters in the kernel's order
+    law_params: tuple[float, ...] = ()
     G: np.ndarray = field(init=False)  # (N*P, n) gap gradients (the geometry's)
     A: np.ndarray = field(init=False)  # (N, n) d eta / dq
     B: np.ndarray = field(init=False)  # (N, n) d zeta / dq
@@ -97,7 +100,7 @@ class ContactModel:
             self._pinned = (*arrays, work)
             self._k = kernel.RRContact(self.n_dofs, self.n_blades, self.n_points, float(self.g0), float(self.k_r),
                                        float(self.mu), float(max(self.geometry.chord, 1e-300)), float(self.v_slip),
-                                       *map(kernel.ptr, self._pinned))
+                                       law_record(self.law, self.law_params), *map(kernel.ptr, self._pinned))
         return self._k
 
     @property
@@ -123,7 +126,8 @@ class ContactModel:
 
     def with_clearance(self, g0: float) -> ContactModel:
         """Same geometry, another nominal clearance (cheap: gaps are affine)."""
-        return ContactModel(self.formulation, self.variant, self.geometry, g0, self.k_r, self.mu, self.v_slip)
+        return ContactModel(self.formulation, self.variant, self.geometry, g0, self.k_r, self.mu, self.v_slip,
+                            self.law, self.law_params)
 
     def _eval(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         q = np.ascontiguousarray(q, dtype=float)
@@ -138,7 +142,7 @@ class ContactModel:
         return self._eval(q)[0]
 
     def laws(self, q: np.ndarray) -> np.ndarray:
-        """Per blade (N, 7): F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction."""
+        """Per blade (N, 8): F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction, potential [J]."""
         return self._eval(q)[1]
 
     @staticmethod
@@ -191,6 +195,26 @@ class ContactModel:
         self._lib.rr_jacobian(k, kernel.ptr(q), None if qd is None else kernel.ptr(qd), float(omega), kernel.ptr(J),
                               None)
         return J
+
+    def potential_of_gaps(self, gaps: np.ndarray) -> np.ndarray:
+        """The law's strain energy, summed over the blades, of states given by their gaps (m, N, P) [J] (the
+        kernel's; its gradient is -F_nl without friction). Gaps rather than states: a run against a worn liner
+        records its gaps to the worn surface, which gaps(q) does not know."""
+        g = np.ascontiguousarray(np.asarray(gaps, dtype=float).reshape(-1, self.n_blades * self.n_points))
+        out = np.empty(g.shape[0])
+        self.lib.rr_potential_batch(self.kernel, int(g.shape[0]), kernel.ptr(g), kernel.ptr(out))
+        return out
+
+    def potential(self, Q: np.ndarray) -> np.ndarray:
+        """The law's strain energy of states Q (m, n) [J]."""
+        return self.potential_of_gaps(self.gaps_batch(np.atleast_2d(Q)))
+
+    def closed_stiffness(self, omega: float) -> np.ndarray:
+        """-dF_nl/dq with every blade in full contact at the law's largest slope, friction at spin omega (the
+        kernel's: what the explicit step and the static solver's starts assume)."""
+        K = np.empty((self.n_dofs, self.n_dofs))
+        self.lib.rr_closed_stiffness(self.kernel, float(omega), kernel.ptr(K))
+        return K
 
     def gaps_batch(self, Q: np.ndarray) -> np.ndarray:
         """Gaps of many states Q (m, n): (m, N, P)."""
@@ -292,7 +316,8 @@ class ContactModel:
 def make_contact(model: Model, formulation: str = "3D", variant: str = "full", **overrides) -> ContactModel:
     """Contact model of ``formulation`` ('2D' or '3D') and 3D ``variant``.
 
-    ``overrides`` replace contact parameters (g0, k_r, mu, theta_deg, chord, slip_velocity).
+    ``overrides`` replace contact parameters (g0, k_r, mu, theta_deg, chord, slip_velocity, law, knee,
+    stiffness_ratio).
     Variants (paper section 4): 'full'; 'kinematics_only' (theta = 0, l_c = 1 mm);
     'geometry_only' (no disk or casing rotation, no blade flexure in the gap).
     """
@@ -303,7 +328,7 @@ def make_contact(model: Model, formulation: str = "3D", variant: str = "full", *
     if formulation == "2D" and variant != "full":
         raise ParameterError(f"variant: '{variant}' applies to the 3D formulation only; accepted for 2D: full")
     c = model.params.contact
-    known = {"g0", "k_r", "mu", "theta_deg", "chord", "slip_velocity"}
+    known = {"g0", "k_r", "mu", "theta_deg", "chord", "slip_velocity", "law", "knee", "stiffness_ratio"}
     bad = set(overrides) - known
     if bad:
         raise ParameterError(f"contact.{sorted(bad)[0]}: unknown; accepted: {', '.join(sorted(known))}")
@@ -316,4 +341,4 @@ def make_contact(model: Model, formulation: str = "3D", variant: str = "full", *
         if variant == "kinematics_only":
             theta, chord = 0.0, 1e-3
         geo = geometry_3d(model, theta, chord, rotations=variant != "geometry_only")
-    return ContactModel(formulation, variant, geo, c.g0, c.k_r, c.mu, c.slip_velocity)
+    return ContactModel(formulation, variant, geo, c.g0, c.k_r, c.mu, c.slip_velocity, c.law, c.law_params)

@@ -51,6 +51,9 @@ class Liner:
     wears: bool = True
     closure: float = 0.0
     offset: tuple[float, float] = (0.0, 0.0)
+    # the casing out of round: {n: (a_n [m], psi_n [rad])}, n = 2..kernel.MAX_LOBES; its inner radius grows by
+    # sum_n a_n cos(n (theta - psi_n)) at fixed-frame angle theta (psi_n: where lobe n is widest)
+    distortion: dict[int, tuple[float, float]] = field(default_factory=dict)
     radius: float = 1.0  # of the casing at the tips [m] (volumes and areas)
     band: float = 0.14  # axial width of the band the tips sweep [m] (the chord's axial extent)
     tip_area: float = 2.2e-3  # a blade tip's footprint on the liner [m^2] (thickness x chord): F_y over it is
@@ -76,7 +79,7 @@ class Liner:
                                        yield_force=float(self.yield_force), hardening=float(self.hardening),
                                        thickness=float(self.thickness), tables=kernel.ptr(self._tables),
                                        depth=kernel.ptr(self.depth), work_weight=self.cell_area / self.tip_area)
-        self.set_inputs(self.closure, self.offset)
+        self.set_inputs(self.closure, self.offset, self.distortion)
         if lib.rr_surface_init(c.kernel, ctypes.byref(self.struct)) != 0:
             raise ParameterError("liner: the kernel refused its parameters")
 
@@ -92,8 +95,11 @@ class Liner:
               "tip_area": p.blades.thickness * p.contact.chord, **overrides}
         return cls(contact, wears=a.enabled if wears is None else bool(wears), **kw)
 
-    def set_inputs(self, closure: float | None = None, offset: tuple[float, float] | None = None) -> None:
-        """The engine's inputs, held from the next step on."""
+    def set_inputs(self, closure: float | None = None, offset: tuple[float, float] | None = None,
+                   distortion: dict[int, tuple[float, float]] | None = None) -> None:
+        """The engine's inputs, held from the next step on (``distortion``: see :meth:`set_distortion`)."""
+        if distortion is not None:
+            self.set_distortion(distortion)
         if closure is not None:
             if not math.isfinite(closure):
                 raise ParameterError(f"clearance closure: {closure!r} is not finite")
@@ -105,6 +111,35 @@ class Liner:
                 raise ParameterError(f"casing offset: {offset!r} is not finite")
             self.offset = (x, y)
             self.struct.offset_x, self.struct.offset_y = x, y
+
+    def set_distortion(self, lobes: dict[int, tuple[float, float]]) -> None:
+        """The casing out of round, held from the next step on: ``{n: (amplitude [m], phase [rad])}`` for lobe
+        counts n = 2..8 (n = 1, a rigid shift, is the offset); the inner radius grows by a_n cos(n (theta - psi_n))
+        at the fixed-frame angle theta, so a blade's gap opens where a_n cos(...) > 0. Lobes not named are round.
+        """
+        amp = [0.0] * (kernel.MAX_LOBES + 1)
+        phase = [0.0] * (kernel.MAX_LOBES + 1)
+        for n, value in dict(lobes).items():
+            if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 2 <= n <= kernel.MAX_LOBES:
+                raise ParameterError(f"casing distortion: lobe count {n!r} out of range; accepted: integers 2 to "
+                                     f"{kernel.MAX_LOBES} (a lobe count of 1 is a rigid shift: the casing offset)")
+            try:
+                a, psi = (float(v) for v in value)
+            except (TypeError, ValueError):
+                raise ParameterError(f"casing distortion: lobe {n}: expected (amplitude [m], phase [rad]), got "
+                                     f"{value!r}") from None
+            if not (math.isfinite(a) and math.isfinite(psi)):
+                raise ParameterError(f"casing distortion: lobe {n}: ({a!r}, {psi!r}) is not finite")
+            amp[int(n)], phase[int(n)] = a, psi
+        self.distortion = {n: (amp[n], phase[n]) for n in range(2, kernel.MAX_LOBES + 1) if amp[n] != 0.0}
+        self.struct.lobe_amp[:] = amp
+        self.struct.lobe_phase[:] = phase
+
+    @property
+    def is_neutral(self) -> bool:
+        """A surface that adds exactly 0 to every gap: rigid, nothing worn, no closure, offset or distortion."""
+        return (not self.wears and self.closure == 0.0 and self.offset == (0.0, 0.0) and not self.distortion
+                and not np.any(self.depth))
 
     # ------------------------------------------------------------------ geometry of the cells
     @property
@@ -150,17 +185,18 @@ class Liner:
 
     def get_state(self) -> tuple:
         return (self.depth.copy(), float(self.struct.phi), float(self.struct.plastic_work), self.closure,
-                self.offset)
+                self.offset, dict(self.distortion), tuple(self.struct.cut_inputs))
 
     def set_state(self, state: tuple) -> None:
-        depth, phi, work, closure, offset = state
+        depth, phi, work, closure, offset, distortion, cut_inputs = state
         depth = np.asarray(depth, dtype=float)
         if depth.shape != self.depth.shape or not np.all(np.isfinite(depth)) or np.any(depth < 0):
             raise ParameterError(f"liner state: depth of shape {depth.shape}, expected {self.depth.shape}, finite, "
                                  ">= 0")
         self.depth[:] = depth  # in place: the kernel holds its address
         self.struct.phi, self.struct.plastic_work = float(phi), float(work)
-        self.set_inputs(closure, offset)
+        self.set_inputs(closure, offset, distortion)
+        self.struct.cut_inputs[:] = [float(v) for v in cut_inputs]
 
     def attach(self, c: kernel.RRContact) -> kernel.RRContact:
         """A copy of the contact's kernel struct that sees this surface."""

@@ -34,8 +34,8 @@ HEADER = HERE / "rotorub_kernel.h"
 INTERNAL_HEADER = HERE / "rr_internal.h"  # declarations shared by the sources, exported by none
 MATH_HEADER = HERE / "rr_math.h"  # the elementary functions: the same bits on every platform
 HEADERS = (HEADER, INTERNAL_HEADER, MATH_HEADER)
-ABI_VERSION = 7
-LAW_WIDTH = 7
+ABI_VERSION = 8
+LAW_WIDTH = 8  # F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction, potential
 OUT_BLADE_BLOCKS = 6
 OUT_GLOBALS = 8
 # names of the per-blade output blocks and of the globals, in the kernel's order (rotorub_kernel.h)
@@ -49,19 +49,34 @@ _dp = ctypes.c_void_p
 _ip = ctypes.c_void_p
 
 
+# the normal laws (rotorub_kernel.h, "contact laws"): the kernel's ids, and each law's parameters in its order
+LAW_IDS = {"penalty": 0, "bilinear": 1}
+LAW_PARAMS = 4
+
+
+class RRLaw(ctypes.Structure):
+    _fields_ = [("id", ctypes.c_int), ("par", ctypes.c_double * LAW_PARAMS)]
+
+
 class RRContact(ctypes.Structure):
     _fields_ = [("n", ctypes.c_int), ("nb", ctypes.c_int), ("np", ctypes.c_int), ("g0", ctypes.c_double),
                 ("k_r", ctypes.c_double), ("mu", ctypes.c_double), ("chord", ctypes.c_double),
-                ("v_slip", ctypes.c_double), ("G", _dp), ("A", _dp), ("B", _dp), ("S", _dp), ("points", _dp),
-                ("normals", _dp), ("tangents", _dp), ("T2", _dp), ("work", _dp), ("surface", ctypes.c_void_p)]
+                ("v_slip", ctypes.c_double), ("law", RRLaw), ("G", _dp), ("A", _dp), ("B", _dp), ("S", _dp),
+                ("points", _dp), ("normals", _dp), ("tangents", _dp), ("T2", _dp), ("work", _dp),
+                ("surface", ctypes.c_void_p)]
+
+
+MAX_LOBES = 8  # casing distortion: lobe counts 2..MAX_LOBES (rotorub_kernel.h RR_MAX_LOBES)
 
 
 class RRSurface(ctypes.Structure):
     _fields_ = [("n_sectors", ctypes.c_int), ("wears", ctypes.c_int), ("yield_force", ctypes.c_double),
                 ("hardening", ctypes.c_double), ("thickness", ctypes.c_double), ("closure", ctypes.c_double),
-                ("offset_x", ctypes.c_double), ("offset_y", ctypes.c_double), ("phi", ctypes.c_double),
+                ("offset_x", ctypes.c_double), ("offset_y", ctypes.c_double),
+                ("lobe_amp", ctypes.c_double * (MAX_LOBES + 1)), ("lobe_phase", ctypes.c_double * (MAX_LOBES + 1)),
+                ("phi", ctypes.c_double),
                 ("work_weight", ctypes.c_double), ("plastic_work", ctypes.c_double), ("changed", ctypes.c_int),
-                ("tables", _dp), ("depth", _dp)]
+                ("tables", _dp), ("depth", _dp), ("cut_inputs", ctypes.c_double * (3 + 2 * (MAX_LOBES + 1)))]
 
 
 WEAR_HARMONICS = 8
@@ -98,7 +113,8 @@ class RRJob(ctypes.Structure):
                 ("t_ramp", ctypes.c_double), ("rec_every", ctypes.c_int), ("rec_cap", ctypes.c_int),
                 ("n_rec", ctypes.c_int), ("rec_q", _dp), ("rec_out", _dp), ("out_index", _ip), ("out_dest", _dp),
                 ("done", ctypes.c_int), ("rec_wear_every", ctypes.c_int), ("rec_wear_cap", ctypes.c_int),
-                ("n_rec_wear", ctypes.c_int), ("rec_wear", _dp), ("stop_on_contact", ctypes.c_int)]
+                ("n_rec_wear", ctypes.c_int), ("rec_wear", _dp), ("stop_on_contact", ctypes.c_int), ("cache", _dp),
+                ("cache_valid", ctypes.c_int)]
 
 
 def source_id() -> str:
@@ -159,8 +175,22 @@ def _declare(lib: ctypes.CDLL) -> ctypes.CDLL:
                                      ctypes.c_int, _dp, ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_int),
                                      _dp, _ip]
     lib.rr_static_newton.restype = ctypes.c_int
-    lib.rr_blade_law.argtypes = [ctypes.c_int, ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_double,
-                                 _dp]
+    law = ctypes.POINTER(RRLaw)
+    lib.rr_blade_law.argtypes = [law, ctypes.c_int, ctypes.c_double, ctypes.c_double, ctypes.c_double,
+                                 ctypes.c_double, _dp]
+    lib.rr_law_check.argtypes = [law]
+    lib.rr_law_check.restype = ctypes.c_int
+    lib.rr_law_max_slope.argtypes = [law]
+    lib.rr_law_max_slope.restype = ctypes.c_double
+    lib.rr_potential_batch.argtypes = [c, ctypes.c_int, _dp, _dp]
+    lib.rr_closed_stiffness.argtypes = [c, ctypes.c_double, _dp]
+    lib.rr_k_omega.argtypes = [ctypes.c_int, _dp, _dp, _dp, _dp, ctypes.c_double, _dp]
+    lib.rr_critical_step.argtypes = [c, ctypes.c_double, _dp, _dp, _dp]
+    lib.rr_critical_step.restype = ctypes.c_double
+    lib.rr_critical_step_work_size.argtypes = [ctypes.c_int]
+    lib.rr_critical_step_work_size.restype = ctypes.c_int
+    lib.rr_cd_cache_size.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_int]
+    lib.rr_cd_cache_size.restype = ctypes.c_int
     lib.rr_laws.argtypes = [c, _dp, _dp, _dp]
     lib.rr_friction.argtypes = [c, _dp, _dp, ctypes.c_double, _dp]
     lib.rr_force.argtypes = [c, _dp, _dp, ctypes.c_double, _dp]
@@ -176,13 +206,13 @@ def _declare(lib: ctypes.CDLL) -> ctypes.CDLL:
     lib.rr_surface_table_size.restype = ctypes.c_int
     lib.rr_surface_init.argtypes = [c, ctypes.c_void_p]
     lib.rr_surface_init.restype = ctypes.c_int
-    lib.rr_liner_law.argtypes = [ctypes.c_double] * 5 + [ctypes.c_int, ctypes.POINTER(ctypes.c_double),
-                                                         ctypes.POINTER(ctypes.c_double)]
+    lib.rr_liner_law.argtypes = [law] + [ctypes.c_double] * 5 + [ctypes.c_int, ctypes.POINTER(ctypes.c_double),
+                                                                 ctypes.POINTER(ctypes.c_double)]
     lib.rr_liner_law.restype = ctypes.c_double
     lib.rr_surface_summary.argtypes = [c, ctypes.c_void_p, ctypes.c_double, _dp]
     lib.rr_surface_summary.restype = None
     for name in ("rr_blade_law", "rr_laws", "rr_friction", "rr_force", "rr_jacobian", "rr_gaps_batch", "rr_outputs",
-                 "rr_outputs_batch"):
+                 "rr_outputs_batch", "rr_potential_batch", "rr_closed_stiffness", "rr_k_omega"):
         getattr(lib, name).restype = None
     return lib
 
@@ -232,27 +262,52 @@ def load() -> ctypes.CDLL:
     return lib
 
 
-def chord_law(g_le: float, g_te: float, k: float, l: float) -> tuple[float, ...]:
-    """The kernel's chord law of one blade: (F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, fraction)."""
+def make_law(name: str = "penalty", params: tuple[float, ...] = ()) -> RRLaw:
+    """The kernel's law record of law ``name`` with its parameters (in the law's order, contact/laws.py)."""
+    if name not in LAW_IDS:
+        raise ValueError(f"law: '{name}' unknown; accepted: {', '.join(LAW_IDS)}")
+    par = [float(v) for v in params] + [0.0] * (LAW_PARAMS - len(params))
+    return RRLaw(LAW_IDS[name], (ctypes.c_double * LAW_PARAMS)(*par))
+
+
+PENALTY = make_law()
+
+
+def blade_law(g_le: float, g_te: float, k: float, l: float, law: RRLaw = PENALTY, np_: int = 2) -> tuple[float, ...]:
+    """The kernel's law of one blade (np_ = 2: the chord law; 1: the point law at g_le): F_N, M_N, dF/deta,
+    dF/dzeta, dM/deta, dM/dzeta, chord fraction, potential."""
     out = (ctypes.c_double * LAW_WIDTH)()
-    load().rr_blade_law(2, float(g_le), float(g_te), float(k), float(l), out)
+    load().rr_blade_law(ctypes.byref(law), int(np_), float(g_le), float(g_te), float(k), float(l), out)
     return tuple(out)
 
 
-def point_law(g: float, k: float) -> tuple[float, float]:
+def chord_law(g_le: float, g_te: float, k: float, l: float, law: RRLaw = PENALTY) -> tuple[float, ...]:
+    """The kernel's chord law of one blade: (F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, fraction)."""
+    return blade_law(g_le, g_te, k, l, law, 2)[:7]
+
+
+def point_law(g: float, k: float, law: RRLaw = PENALTY) -> tuple[float, float]:
     """The kernel's point law: (F_N, dF/dg)."""
-    out = (ctypes.c_double * LAW_WIDTH)()
-    load().rr_blade_law(1, float(g), 0.0, float(k), 1.0, out)
+    out = blade_law(g, 0.0, k, 1.0, law, 1)
     return out[0], out[2]
 
 
 def liner_law(g: float, k: float, fy: float, h: float, thickness: float, depth: float = 0.0,
-              wears: bool = True) -> tuple[float, float, float]:
+              wears: bool = True, law: RRLaw = PENALTY) -> tuple[float, float, float]:
     """The kernel's abradable-liner law at one cell: (force, depth after the cut, work dissipated)."""
     d, w = ctypes.c_double(float(depth)), ctypes.c_double(0.0)
-    f = load().rr_liner_law(float(g), float(k), float(fy), float(h), float(thickness), int(bool(wears)),
-                            ctypes.byref(d), ctypes.byref(w))
+    f = load().rr_liner_law(ctypes.byref(law), float(g), float(k), float(fy), float(h), float(thickness),
+                            int(bool(wears)), ctypes.byref(d), ctypes.byref(w))
     return f, d.value, w.value
+
+
+def k_omega(K: np.ndarray, S2: np.ndarray, N2: np.ndarray, C1: np.ndarray, omega: float) -> np.ndarray:
+    """The kernel's K(Omega) = K + Omega^2 (S2 + N2) + Omega C1 (the FMUs' and the time loop's bits)."""
+    n = K.shape[0]
+    arrays = [np.ascontiguousarray(a, dtype=float) for a in (K, S2, N2, C1)]
+    out = np.empty((n, n))
+    load().rr_k_omega(n, *map(ptr, arrays), float(omega), ptr(out))
+    return out
 
 
 def eigenvalues(A: np.ndarray) -> np.ndarray:
@@ -306,7 +361,8 @@ def iptr(a: np.ndarray) -> int:
 
 
 __all__ = [
-    "ABI_VERSION", "CompilerError", "LAW_WIDTH", "OUT_BLADE_NAMES", "OUT_GLOBAL_NAMES", "RRContact", "RRGeometry",
+    "ABI_VERSION", "CompilerError", "LAW_IDS", "LAW_WIDTH", "MAX_LOBES", "OUT_BLADE_NAMES", "PENALTY", "RRLaw",
+    "blade_law", "k_omega", "liner_law", "make_law", "OUT_GLOBAL_NAMES", "RRContact", "RRGeometry",
     "RRGeometrySpec", "RRJob", "RRMatrices", "RRState", "build", "cache_dir", "chord_law", "eigenvalues", "elementary",
     "inverse",
     "iptr", "load", "point_law", "ptr", "source_id",

@@ -50,10 +50,28 @@ extern "C" {
 #endif
 
 /* Bumped whenever a struct layout or a signature below changes. */
-#define RR_ABI_VERSION 7
+#define RR_ABI_VERSION 8
 
-/* Per-blade law values (rr_laws): F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction. */
-#define RR_LAW_WIDTH 7
+/* Per-blade law values (rr_laws): F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction, potential. */
+#define RR_LAW_WIDTH 8
+
+/* ------------------------------------------------------------------ contact laws
+ * The normal law of a blade tip, as named data with one dispatch (rr_laws.c): a law id and its parameters.
+ * The law gives the pressure p(delta) of a penetration delta = -gap >= 0 per unit chord, k_r / l_c times
+ * a shape (3D), or the tip force k_r times the shape (2D): a chord pressed uniformly carries k_r times the
+ * shape in both formulations. Everything derived from the law (forces, moments and their derivatives, the
+ * potential for the energy checks, the largest slope for the explicit scheme's step, the liner's return
+ * map) is computed here, for the library and both FMUs.
+ *   RR_LAW_PENALTY   shape delta                                  (the paper's penalty law)
+ *   RR_LAW_BILINEAR  shape delta + (ratio - 1) (delta - knee)_+    (a coating then a stiffer, ratio > 1, or
+ *                    softer, ratio < 1, layer beyond the knee penetration; par: knee [m] > 0, ratio > 0) */
+enum { RR_LAW_PENALTY = 0, RR_LAW_BILINEAR = 1, RR_N_LAWS };
+enum { RR_BILINEAR_KNEE = 0, RR_BILINEAR_RATIO = 1 };
+#define RR_LAW_PARAMS 4
+typedef struct {
+    int id;                      /* RR_LAW_* */
+    double par[RR_LAW_PARAMS];   /* the law's parameters, in its enum's order (unused ones 0) */
+} rr_law;
 
 /* Layout of the outputs of a state (rr_outputs): six per-blade blocks, then globals. */
 enum {
@@ -95,6 +113,7 @@ RR_API void rr_elementary(int fn, int m, const double *x, const double *y, doubl
  * surface is read by every function below that evaluates gaps, at the frame angle phi; only the time loop
  * (rr_cd_run) cuts it. Arrays are owned by the caller; rr_surface_init fills the tables. */
 #define RR_WEAR_HARMONICS 8 /* profile harmonics in the summary */
+#define RR_MAX_LOBES 8      /* casing distortion: lobe counts 2..RR_MAX_LOBES (1 is the offset) */
 typedef struct {
     int n_sectors;       /* cells over 2 pi (>= 8) */
     int wears;           /* 1: cut by the law; 0: a fixed surface (the liner as it is, closure, offset) */
@@ -104,6 +123,11 @@ typedef struct {
     double closure;      /* uniform closure of the clearance [m] (engine input; > 0 closes) */
     double offset_x;     /* rigid offset of the casing centre, fixed frame [m] (engine input) */
     double offset_y;
+    /* the casing out of round (engine input): its inner radius grows by sum_n a_n cos(n (th - psi_n)), n = 2..
+     * RR_MAX_LOBES, th the fixed-frame angle (psi_n: where a lobe is widest); a point's gap grows by n_r times
+     * that. Entries 0 and 1 unused (lobe 1 is the offset). */
+    double lobe_amp[RR_MAX_LOBES + 1];   /* a_n [m] */
+    double lobe_phase[RR_MAX_LOBES + 1]; /* psi_n [rad] */
     double phi;          /* frame angle of the state the gaps are evaluated at; the time loop keeps it [rad] */
     double work_weight;  /* a cell's area over a blade tip's (the law is a tip's): the plastic work per cell is
                           * the law's times this, so that it is the yield pressure times the volume, whatever
@@ -112,6 +136,9 @@ typedef struct {
     int changed;         /* set when a cell is cut (a summary clears nothing: for the caller) */
     double *tables;      /* rr_surface_table_size(nb, np, n_sectors) doubles, filled by rr_surface_init */
     double *depth;       /* (np, n_sectors) worn depth [m] (state) */
+    /* the inputs (closure, offset, lobes) the time loop last cut at; rr_surface_init clears them (NaN) so that
+     * the first run cuts at its inputs before its first force (kernel-managed) */
+    double cut_inputs[3 + 2 * (RR_MAX_LOBES + 1)];
 } rr_surface;
 
 /* Contact geometry and law parameters of one formulation (all arrays owned by the caller). */
@@ -124,6 +151,7 @@ typedef struct {
     double mu;        /* Coulomb friction coefficient */
     double chord;     /* chord length l_c [m] (any positive value for np = 1) */
     double v_slip;    /* velocity scale of the friction regularisation tanh(v / v_slip) [m/s] (> 0) */
+    rr_law law;       /* the normal law (RR_LAW_PENALTY: the paper's) */
     const double *G;  /* (nb*np, n) gap gradients: gap = g0 + G q */
     const double *A;  /* (nb, n) d eta / dq   (mean gap along the chord) */
     const double *B;  /* (nb, n) d zeta / dq  (gap slope along the chord) */
@@ -201,8 +229,21 @@ RR_API int rr_work_size(int n, int nb, int np);
 /* Build the contact geometry of eq. (1) (2D) or eq. (3)-(4) linearised (3D; see docs/THEORY.md 4).
  * Returns 0, or -1 if the spec is invalid (np not 1 or 2, chord <= 0 in 3D). */
 RR_API int rr_contact_geometry(const rr_geometry_spec *spec, rr_geometry *out);
-/* The law of one blade from its gaps: np = 2 chord law (g_le, g_te), np = 1 point law (g_le). */
-RR_API void rr_blade_law(int np, double g_le, double g_te, double k, double l, double *out);
+/* The law of one blade from its gaps: np = 2 chord law (g_le, g_te), np = 1 point law (g_le); out: RR_LAW_WIDTH
+ * values. */
+RR_API void rr_blade_law(const rr_law *law, int np, double g_le, double g_te, double k, double l, double *out);
+/* 0 if the law's id and parameters are valid, else -1. */
+RR_API int rr_law_check(const rr_law *law);
+/* The law's largest slope over its penetrations, per unit k_r (penalty: 1; bilinear: max(1, ratio)): what the
+ * explicit scheme's stability limit must assume with every contact closed. */
+RR_API double rr_law_max_slope(const rr_law *law);
+/* The contact potential (the law's strain energy, summed over the blades) of m states given by their gaps
+ * (m x nb*np, e.g. rr_gaps_batch's, or a run's gaps to a worn surface) [J]: its gradient is -F_nl without
+ * friction. */
+RR_API void rr_potential_batch(const rr_contact *c, int m, const double *gaps, double *out);
+/* -dF_nl/dq with every blade in full contact at the law's largest slope (no surface): the stiffness the
+ * explicit scheme's step and the static solver's starts assume (n x n, friction's part at spin omega). */
+RR_API void rr_closed_stiffness(const rr_contact *c, double omega, double *Kc);
 /* Gaps (nb*np) and per-blade law values (nb x RR_LAW_WIDTH) at q. */
 RR_API void rr_laws(const rr_contact *c, const double *q, double *gaps, double *law);
 /* Friction factors mu tanh(v_p / v_slip) of the nb*np points at (q, q', omega) (0 where the blade
@@ -253,7 +294,16 @@ typedef struct {
      * an FMI 3.0 event), done < n_steps then and state->diverged unset; 0: run every step. The steps taken are
      * those of a run of done steps, bit for bit. */
     int stop_on_contact;
+    /* NULL, or rr_cd_cache_size(n, nb, np) doubles: the contact evaluation of the final state is kept there with
+     * what it depends on, and the next call starts from it instead of evaluating it again when that state and
+     * those inputs are the same (a co-simulation step then costs what its substeps cost). The caller sets
+     * cache_valid = 0 when it points the job at another contact; the kernel manages it otherwise. A surface that
+     * wears is never cached. */
+    double *cache;
+    int cache_valid;
 } rr_cd_job;
+/* doubles of an rr_cd_job's cache */
+RR_API int rr_cd_cache_size(int n, int nb, int np);
 
 /* Advance job->n_steps central-difference steps at constant matrices, external force
  * f * me * r(t) + f0; the friction of each step uses the velocity (q - q_prev) / dt. Returns the steps done; fewer than n_steps if a gap fell below -max_pen or a
@@ -267,16 +317,21 @@ RR_API int rr_surface_table_size(int nb, int np, int n_sectors);
  * and normals, the profile's Fourier basis). Returns 0, or -1 if a parameter is out of range. */
 RR_API int rr_surface_init(const rr_contact *c, rr_surface *s);
 /* The liner's law at one cell: a point of raw gap g (its gap to the unworn surface, closure and offset
- * included) over a cell worn to *depth; stiffness k, yield force fy, hardening h, thickness, all of the
- * point's share. Cuts *depth (if wears) and adds the dissipated work to *work; returns the point's normal
- * force k (-(g + depth))_+ after the cut. */
-RR_API double rr_liner_law(double g, double k, double fy, double h, double thickness, int wears, double *depth,
-                           double *work);
+ * included) over a cell worn to *depth; the point's share of the normal law (law, stiffness k), yield force fy,
+ * hardening h, thickness. Elastic (the law) while its force stays below fy + h depth, else the cell is cut so
+ * that the force returns to that bound (a return map, exact for every law here: they are piecewise linear).
+ * Cuts *depth (if wears) and adds the dissipated work to *work; returns the point's normal force after the cut. */
+RR_API double rr_liner_law(const rr_law *law, double g, double k, double fy, double h, double thickness, int wears,
+                           double *depth, double *work);
 /* Summary of the worn profile (the rows' mean at every cell) into out[RR_WEAR_OUT]: largest and mean
  * depth [m], removed volume [m^3] (area_per_sector: a cell's area on the casing, m^2), the plastic work
- * [J], the dominant lobe count (the harmonic 1..RR_WEAR_HARMONICS of largest amplitude; 0 for a profile
- * without wear, or worn evenly: no harmonic reaches 1 % of the mean depth) and the amplitudes of harmonics
- * 1..RR_WEAR_HARMONICS [m]. */
+ * [J], the dominant lobe count and the amplitudes of harmonics 1..RR_WEAR_HARMONICS [m]. The lobe rule: a profile
+ * whose every harmonic is below RR_LOBE_UNIFORM times the mean depth is worn evenly (0 lobes); otherwise the largest
+ * harmonic h is the lobe count when its amplitude is at least RR_LOBE_DOMINANCE times that of every harmonic that
+ * is not a multiple of h (an h-lobed profile that is not a pure sinusoid has harmonics 2h, 3h, ... too), else 0
+ * (no lobe dominates). 0 also when nothing is worn. */
+#define RR_LOBE_DOMINANCE 2.0
+#define RR_LOBE_UNIFORM 0.05
 enum { RR_WEAR_MAX = 0, RR_WEAR_MEAN, RR_WEAR_VOLUME, RR_WEAR_WORK, RR_WEAR_LOBES, RR_WEAR_AMP,
        RR_WEAR_OUT = RR_WEAR_AMP + RR_WEAR_HARMONICS };
 RR_API void rr_surface_summary(const rr_contact *c, const rr_surface *s, double area_per_sector, double *out);
@@ -313,6 +368,16 @@ RR_API int rr_static_solve(const rr_contact *c, double omega, const double *K, c
  * must stay on the branch it follows. Returns 1 (converged) or 0; work and iwork as rr_static_solve. */
 RR_API int rr_static_newton(const rr_contact *c, double omega, const double *K, const double *F, double tol,
                             int max_iter, double *q, double *residual, int *iterations, double *work, int *iwork);
+
+/* K(Omega) = K0 + omega^2 (S2 + N2) + omega C1 (n x n), in that order of operations (the library's matrices,
+ * the FMUs' and the time loop's are the same bits). */
+RR_API void rr_k_omega(int n, const double *K0, const double *S2, const double *N2, const double *C1, double omega,
+                       double *out);
+/* The explicit central-difference stability limit 2 / omega_max at spin omega: omega_max^2 the largest |eigenvalue|
+ * of Minv (Kw + Kc), Kw = K(omega), Kc = rr_closed_stiffness (every blade closed at the law's largest slope).
+ * work: 2 n*n + 3 n doubles. Returns the limit [s], or -1 if the eigenvalue iteration failed. */
+RR_API double rr_critical_step(const rr_contact *c, double omega, const double *Minv, const double *Kw, double *work);
+RR_API int rr_critical_step_work_size(int n);
 
 /* The central-difference matrices at spin speed omega, angular acceleration omega_dot and step dt,
  * assembled in the library's order of operations: C = D + omega G1,

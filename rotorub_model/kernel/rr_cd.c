@@ -42,6 +42,86 @@ void rri_cd_update(int n, int nb, int np, double l, const double *restrict law, 
     }
 }
 
+/* ------------------------------------------------------------------ the contact evaluation kept between calls */
+/* key: omega, dt, the contact's scalars and law, whether a surface is seen and, for a fixed one, its angle and
+ * inputs; then q, q_prev and the evaluation (gaps, laws, friction factors) */
+#define RR_CACHE_KEY (8 + RR_LAW_PARAMS + 2 + 3 + 2 * (RR_MAX_LOBES + 1))
+
+int rr_cd_cache_size(int n, int nb, int np) { return RR_CACHE_KEY + 2 * n + 2 * nb * np + nb * RR_LAW_WIDTH; }
+
+static void cache_key(const rr_cd_state *s, const rr_contact *c, double omega, double dt, double *key)
+{
+    const rr_surface *sf = c->surface;
+    int i, k = 0;
+    key[k++] = omega;
+    key[k++] = dt;
+    key[k++] = c->g0;
+    key[k++] = c->k_r;
+    key[k++] = c->mu;
+    key[k++] = c->v_slip;
+    key[k++] = c->chord;
+    key[k++] = (double)c->law.id;
+    for (i = 0; i < RR_LAW_PARAMS; ++i) key[k++] = c->law.par[i];
+    key[k++] = sf ? 1.0 : 0.0;
+    key[k++] = sf ? s->phi : 0.0;
+    key[k++] = sf ? sf->closure : 0.0;
+    key[k++] = sf ? sf->offset_x : 0.0;
+    key[k++] = sf ? sf->offset_y : 0.0;
+    for (i = 0; i <= RR_MAX_LOBES; ++i) {
+        key[k++] = sf ? sf->lobe_amp[i] : 0.0;
+        key[k++] = sf ? sf->lobe_phase[i] : 0.0;
+    }
+}
+
+/* the evaluation kept by the last call, if it was made at this state with these inputs: into gaps, law, fr */
+static int cache_take(rr_cd_job *job, const rr_contact *c, double omega, double dt, double *gaps, double *law,
+                      double *fr)
+{
+    const rr_cd_state *s = job->state;
+    int i, n = c->n, rows = c->nb * c->np, nl = c->nb * RR_LAW_WIDTH;
+    double key[RR_CACHE_KEY];
+    const double *kc = job->cache, *qc, *qpc, *g, *L, *f;
+    if (!kc || !job->cache_valid || (c->surface && c->surface->wears)) return 0;
+    qc = kc + RR_CACHE_KEY;
+    qpc = qc + n;
+    g = qpc + n;
+    L = g + rows;
+    f = L + nl;
+    cache_key(s, c, omega, dt, key);
+    for (i = 0; i < RR_CACHE_KEY; ++i)
+        if (!(key[i] == kc[i])) return 0;
+    for (i = 0; i < n; ++i)
+        if (!(s->q[i] == qc[i]) || !(s->q_prev[i] == qpc[i])) return 0;
+    for (i = 0; i < rows; ++i) gaps[i] = g[i];
+    for (i = 0; i < nl; ++i) law[i] = L[i];
+    for (i = 0; i < rows; ++i) fr[i] = f[i];
+    return 1;
+}
+
+static void cache_keep(rr_cd_job *job, const rr_contact *c, double omega, double dt, const double *gaps,
+                       const double *law, const double *fr)
+{
+    const rr_cd_state *s = job->state;
+    int i, n = c->n, rows = c->nb * c->np, nl = c->nb * RR_LAW_WIDTH;
+    double *kc = job->cache, *qc, *qpc, *g, *L, *f;
+    job->cache_valid = 0;
+    if (!kc || (c->surface && c->surface->wears) || s->diverged) return;
+    qc = kc + RR_CACHE_KEY;
+    qpc = qc + n;
+    g = qpc + n;
+    L = g + rows;
+    f = L + nl;
+    cache_key(s, c, omega, dt, kc);
+    for (i = 0; i < n; ++i) {
+        qc[i] = s->q[i];
+        qpc[i] = s->q_prev[i];
+    }
+    for (i = 0; i < rows; ++i) g[i] = gaps[i];
+    for (i = 0; i < nl; ++i) L[i] = law[i];
+    for (i = 0; i < rows; ++i) f[i] = fr[i];
+    job->cache_valid = 1;
+}
+
 /* The law and the friction are evaluated once per state: at the end of a step they serve both the
  * record of the new state and the next step's contact force. */
 int rr_cd_run(rr_cd_job *job)
@@ -65,9 +145,18 @@ int rr_cd_run(rr_cd_job *job)
     job->done = 0;
     if (s->diverged) return 0;
     if (sf) sf->phi = s->phi; /* the surface is read, and cut, at the state's angle */
-    rri_gaps_of(c, q, gaps);
-    rri_laws_of(c, gaps, law);
-    rri_friction_of(c, law, omega, NULL, q, qp, dt, fr);
+    if (sf && sf->wears && rri_surface_inputs_changed(sf)) {
+        /* the engine's inputs changed since the last cut (or none yet): the return map sees the new surface
+         * before the first force, so a jump while cutting keeps the force at the yield bound (the liner's law
+         * is then exact whatever the inputs do between calls, not only for slow changes) */
+        rri_surface_recut(c, q, gaps);
+        job->cache_valid = 0;
+    }
+    if (!cache_take(job, c, omega, dt, gaps, law, fr)) {
+        rri_gaps_of(c, q, gaps);
+        rri_laws_of(c, gaps, law);
+        rri_friction_of(c, law, omega, NULL, q, qp, dt, fr);
+    }
     for (k = 0; k < rows; ++k)
         if (gaps[k] < 0.0) open = 0;
     for (i = 0; i < job->n_steps; ++i) {
@@ -129,5 +218,57 @@ int rr_cd_run(rr_cd_job *job)
     job->n_rec = written;
     job->done = done;
     if (job->out_dest) rri_outputs_from_law(c, q, gaps, law, fr, s->phi, job->out_index, job->out_dest);
+    cache_keep(job, c, omega, dt, gaps, law, fr);
     return done;
+}
+
+/* ------------------------------------------------------------------ the scheme's matrices and step limit */
+
+void rr_k_omega(int n, const double *K0, const double *S2, const double *N2, const double *C1, double omega,
+                double *out)
+{
+    size_t i, nn = (size_t)n * n;
+    double ww = omega * omega;
+    for (i = 0; i < nn; ++i) out[i] = K0[i] + ww * (S2[i] + N2[i]) + omega * C1[i];
+}
+
+int rr_critical_step_work_size(int n) { return 2 * n * n + 3 * n; }
+
+double rr_critical_step(const rr_contact *c, double omega, const double *Minv, const double *Kw, double *work)
+{
+    int n = c->n, i, j, k;
+    size_t nn = (size_t)n * n;
+    double *Kc = work, *P = work + nn, *wr = P + nn, *wi = wr + n, *ework = wi + n, big = 0.0;
+    rr_closed_stiffness(c, omega, Kc);
+    for (i = 0; i < (int)nn; ++i) Kc[i] = Kw[i] + Kc[i];
+    for (i = 0; i < n; ++i)
+        for (j = 0; j < n; ++j) {
+            double s = 0.0;
+            for (k = 0; k < n; ++k) s += Minv[(size_t)i * n + k] * Kc[(size_t)k * n + j];
+            P[(size_t)i * n + j] = s;
+        }
+    if (rr_eigenvalues(n, P, wr, wi, ework) != 0) return -1.0;
+    for (i = 0; i < n; ++i) {
+        double a = rr_sqrt(wr[i] * wr[i] + wi[i] * wi[i]);
+        if (a > big) big = a;
+    }
+    return 2.0 / rr_sqrt(big);
+}
+
+int rr_cd_build(int n, const double *M, const double *D, const double *K0, const double *G1, const double *C1,
+                   const double *N2, const double *S2, const double *E1, double omega, double omega_dot, double dt,
+                   double *Ainv, double *K2, double *Cm1, double *work, int *piv)
+{
+    size_t i, nn = (size_t)n * n;
+    double dt2 = dt * dt, ww = omega * omega, two_dt = 2.0 * dt;
+    double *Aeff = work + nn;
+    for (i = 0; i < nn; ++i) {
+        double C = D[i] + omega * G1[i];
+        double K = K0[i] + ww * (S2[i] + N2[i]) + omega * C1[i];
+        if (E1) K = K + omega_dot * E1[i];
+        Aeff[i] = M[i] / dt2 + C / two_dt;
+        K2[i] = 2.0 * M[i] / dt2 - K;
+        Cm1[i] = M[i] / dt2 - C / two_dt;
+    }
+    return rr_inverse(n, Aeff, Ainv, work, piv);
 }

@@ -25,10 +25,8 @@ void rri_laws_of(const rr_contact *c, const double *gaps, double *law)
 {
     int j;
     for (j = 0; j < c->nb; ++j) {
-        if (c->np == 2)
-            rri_chord_law(gaps[2 * j], gaps[2 * j + 1], c->k_r, c->chord, law + RR_LAW_WIDTH * j);
-        else
-            rri_point_law(gaps[j], c->k_r, law + RR_LAW_WIDTH * j);
+        const double *g = gaps + (size_t)c->np * j;
+        rri_blade_law(&c->law, c->np, g[0], g[c->np - 1], c->k_r, c->chord, law + RR_LAW_WIDTH * j);
     }
 }
 
@@ -36,6 +34,44 @@ void rr_laws(const rr_contact *c, const double *q, double *gaps, double *law)
 {
     rri_gaps_of(c, q, gaps);
     rri_laws_of(c, gaps, law);
+}
+
+void rr_potential_batch(const rr_contact *c, int m, const double *gaps, double *out)
+{
+    int i, j, np = c->np, rows = c->nb * np;
+    double L[RR_LAW_WIDTH];
+    for (i = 0; i < m; ++i) {
+        const double *g = gaps + (size_t)i * rows;
+        double v = 0.0;
+        for (j = 0; j < c->nb; ++j) {
+            rri_blade_law(&c->law, np, g[np * j], g[np * j + np - 1], c->k_r, c->chord, L);
+            v += L[7];
+        }
+        out[i] = v;
+    }
+}
+
+rr_contact rri_closed_contact(const rr_contact *c)
+{
+    rr_contact closed = *c;
+    int i;
+    closed.g0 = -1.0;
+    closed.surface = NULL; /* every blade closed: the surface changes nothing the stiffness sees */
+    closed.k_r = c->k_r * rri_law_max_slope(&c->law);
+    closed.law.id = RR_LAW_PENALTY;
+    for (i = 0; i < RR_LAW_PARAMS; ++i) closed.law.par[i] = 0.0;
+    return closed;
+}
+
+void rr_closed_stiffness(const rr_contact *c, double omega, double *Kc)
+{
+    /* the law's Jacobian at g0 = -1, q = 0 (the friction's part needs the slopes only, not the force) */
+    rr_contact closed = rri_closed_contact(c);
+    int i, n = c->n;
+    double *zero = c->work + (c->nb * c->np + c->nb * RR_LAW_WIDTH + c->nb * c->np); /* the rhs scratch: n */
+    for (i = 0; i < n; ++i) zero[i] = 0.0;
+    rr_jacobian(&closed, zero, NULL, omega, Kc, NULL);
+    for (i = 0; i < n * n; ++i) Kc[i] = -Kc[i];
 }
 
 void rr_gaps_batch(const rr_contact *c, int m, const double *Q, double *gaps)

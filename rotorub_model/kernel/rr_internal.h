@@ -5,10 +5,10 @@
  * The kernel's files, one concern each:
  *   rr_core.c      version, source id, scratch sizes, the elementary functions for tests
  *   rr_geometry.c  the contact geometry of the 2D and 3D formulations (gap gradients, sliding rows)
- *   rr_laws.c      the normal contact laws of one blade (point and chord laws)
+ *   rr_laws.c      the normal contact laws of one blade, one dispatch (penalty, bilinear)
  *   rr_contact.c   gaps, friction, the generalised contact force and its Jacobians, outputs of a state
- *   rr_liner.c     the casing surface: abradable liner, clearance closure, casing offset
- *   rr_cd.c        explicit central differences (the time loop and its matrices)
+ *   rr_liner.c     the casing surface: abradable liner, clearance closure, casing offset and distortion
+ *   rr_cd.c        explicit central differences (the time loop, its matrices, K(Omega), the stability limit)
  *   rr_linalg.c    dense linear algebra: LU, inverse, eigenvalues
  *   rr_static.c    balanced static solutions (Newton)
  */
@@ -21,9 +21,11 @@
 #include "rotorub_kernel.h"
 #include "rr_math.h" /* sin, cos, tan, atan2, tanh, sqrt: the same bits on every platform */
 
-/* rr_laws.c */
-void rri_chord_law(double g_le, double g_te, double k, double l, double *out);
-void rri_point_law(double g, double k, double *out);
+/* rr_laws.c: the one dispatch of the normal laws */
+void rri_blade_law(const rr_law *law, int np, double g_le, double g_te, double k, double l, double *out);
+double rri_law_max_slope(const rr_law *law);
+/* the force of a point's share k of the law at penetration pen (>= 0 where it touches) */
+double rri_point_force(const rr_law *law, double pen, double k);
 
 /* rr_contact.c */
 void rri_raw_gaps(const rr_contact *c, const double *q, double *gaps);
@@ -31,6 +33,8 @@ void rri_gaps_of(const rr_contact *c, const double *q, double *gaps);
 void rri_laws_of(const rr_contact *c, const double *gaps, double *law);
 void rri_friction_of(const rr_contact *c, const double *law, double omega, const double *qdot, const double *q,
                      const double *q_prev, double dt, double *fr);
+/* a copy of c with every blade closed (g0 = -1 m) under a linear law at the law's largest slope, no surface */
+rr_contact rri_closed_contact(const rr_contact *c);
 void rri_outputs_from_law(const rr_contact *c, const double *q, const double *gaps, const double *law,
                           const double *fr, double phi, const int *index, double *dest);
 
@@ -44,8 +48,12 @@ void rri_cd_update(int n, int nb, int np, double l, const double *restrict law, 
 /* rr_liner.c */
 void rri_surface_apply(const rr_contact *c, double *gaps);
 void rri_surface_cut(const rr_contact *c, const double *gaps, double phi_new);
-double rri_liner_law(double g, double k, double fy, double h, double thickness, int wears, double *depth,
-                     double *work);
+double rri_liner_law(const rr_law *law, double g, double k, double fy, double h, double thickness, int wears,
+                     double *depth, double *work);
+/* the surface's inputs differ from those it was last cut at */
+int rri_surface_inputs_changed(const rr_surface *s);
+/* cut every point's current cell at state q under the surface's inputs (noted as cut at); gaps: scratch */
+void rri_surface_recut(const rr_contact *c, const double *q, double *gaps);
 
 /* small and on the hot path: inline in every file */
 /* Share of the blade's normal force carried by each contact point: the pressure p(c) >= 0 on

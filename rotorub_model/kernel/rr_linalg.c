@@ -284,21 +284,3 @@ int rr_eigenvalues(int n, double *A, double *wr, double *wi, double *work)
     hessenberg(n, A, work);
     return hqr(n, A, wr, wi);
 }
-
-int rr_cd_build(int n, const double *M, const double *D, const double *K0, const double *G1, const double *C1,
-                   const double *N2, const double *S2, const double *E1, double omega, double omega_dot, double dt,
-                   double *Ainv, double *K2, double *Cm1, double *work, int *piv)
-{
-    size_t i, nn = (size_t)n * n;
-    double dt2 = dt * dt, ww = omega * omega, two_dt = 2.0 * dt;
-    double *Aeff = work + nn;
-    for (i = 0; i < nn; ++i) {
-        double C = D[i] + omega * G1[i];
-        double K = K0[i] + ww * (S2[i] + N2[i]) + omega * C1[i];
-        if (E1) K = K + omega_dot * E1[i];
-        Aeff[i] = M[i] / dt2 + C / two_dt;
-        K2[i] = 2.0 * M[i] / dt2 - K;
-        Cm1[i] = M[i] / dt2 - C / two_dt;
-    }
-    return rr_inverse(n, Aeff, Ainv, work, piv);
-}

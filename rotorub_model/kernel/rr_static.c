@@ -151,12 +151,8 @@ int rr_static_solve(const rr_contact *c, double omega, const double *K, const do
         } else if (kk <= 4) {
             double frac = fracs[kk - 2];
             if (!have_kc) {
-                /* -dF_nl/dq with every blade in full contact: the law's Jacobian at g0 = -1, q = 0 */
-                rr_contact closed = *c;
-                closed.g0 = -1.0;
-                for (i = 0; i < n; ++i) start[i] = 0.0;
-                rr_jacobian(&closed, start, NULL, omega, Kc, NULL);
-                for (i = 0; i < n * n; ++i) Kc[i] = -Kc[i];
+                /* -dF_nl/dq with every blade in full contact (at the law's largest slope) */
+                rr_closed_stiffness(c, omega, Kc);
                 have_kc = 1;
             }
             for (i = 0; i < n * n; ++i) nw[i] = K[i] + frac * Kc[i];

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import kernel
 from .blades import bladed_disk_matrices
 from .casing import casing_matrices
 from .frames import MATRIX_KEYS, Matrices
@@ -59,8 +60,9 @@ class Model:
         return omega * self.G1
 
     def K_omega(self, omega: float) -> np.ndarray:
-        """K(Omega) = K + Ks(Omega^2) + N(Omega) + C(Omega)."""
-        return self.K + omega * omega * (self.S2 + self.N2) + omega * self.C1
+        """K(Omega) = K + Ks(Omega^2) + N(Omega) + C(Omega): the kernel's (rr_k_omega), the same bits the FMUs and
+        the time loop's matrices use."""
+        return kernel.k_omega(self.K, self.S2, self.N2, self.C1, float(omega))
 
     def force(self, omega: float, me: float | None = None, omega_dot: float = 0.0) -> np.ndarray:
         """Imbalance force F(Omega^2) (constant in the rotating frame); with an angular

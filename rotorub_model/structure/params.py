@@ -148,20 +148,42 @@ class ImbalanceParams:
 
 @dataclass(frozen=True)
 class ContactParams:
-    k_r: float = _f(0, lo_open=True, doc="normal penalty stiffness of one whole blade tip [N/m]")
-    mu: float = _f(0, 2, doc="Coulomb friction coefficient")
-    theta_deg: float = _f(0, 60, doc="inclination of the conical casing inner surface [deg]")
-    chord: float = _f(0, lo_open=True, doc="blade tip chord length l_c [m]")
+    # The ranges are the project's one declaration of what each parameter accepts: the parameter file, the FMUs'
+    # declared min/max and the CLI read them here (accepted_range). Where a bound is a modelling judgement, the
+    # doc says why; the FMU's g0 narrows its lower end to -max_penetration (deeper diverges at t = 0).
+    k_r: float = _f(1e3, 1e10, doc="normal penalty stiffness of one whole blade tip [N/m] (1e3: no force to speak "
+                                   "of; 1e10: the stable explicit step shrinks as 1/sqrt(k_r))")
+    mu: float = _f(0, 1, doc="Coulomb friction coefficient (1: beyond dry titanium on any coating)")
+    theta_deg: float = _f(0, 60, doc="inclination of the conical casing inner surface [deg] (the paper studies "
+                                     "0-30; the linearised cone gap degrades towards 90)")
+    chord: float = _f(1e-3, 0.5, doc="blade tip chord length l_c [m]")
     g0: float = _f(-INF, doc="nominal tip clearance [m] (negative = initial interference)")
-    slip_velocity: float = _f(0, 10.0, lo_open=True, default=0.1,
+    slip_velocity: float = _f(1e-4, 10.0, default=0.1,
                               doc="velocity scale of the friction regularisation mu tanh(v / v_slip) [m/s] "
                                   "(default 0.1 m/s: far below the tip speeds of the paper's range (30 m/s at "
                                   "Omega_ref), where friction is the exact Coulomb law, and large enough that the "
                                   "explicit scheme stays stable, docs/THEORY.md)")
-    max_penetration: float = _f(0, 0.05, lo_open=True, default=3.0e-3,
+    max_penetration: float = _f(1e-5, 0.05, default=3.0e-3,
                                 doc="penetration beyond which a transient is declared diverged [m] (default 3 mm: "
                                     "the depth of a fan-case abradable liner; deeper, the blade cuts the case "
                                     "structure and the penalty law means nothing)")
+    law: str = field(default="penalty", metadata={
+        "choices": ("penalty", "bilinear"),
+        "doc": "normal contact law (docs/THEORY.md 4.2): penalty (the paper's, F = k_r delta) or bilinear (a coating "
+               "then a stiffer or softer layer: F = k_r delta + (stiffness_ratio - 1) k_r (delta - knee)_+)"})
+    knee: float = _f(1e-6, 0.05, default=0.5e-3,
+                     doc="bilinear law: the penetration where the stiffness changes [m] (default 0.5 mm: a thin "
+                         "coating over a stiffer layer)")
+    stiffness_ratio: float = _f(0.01, 100.0, default=4.0,
+                                doc="bilinear law: the stiffness beyond the knee over k_r (> 1 stiffens, < 1 "
+                                    "softens; default 4; the explicit step shrinks as 1/sqrt of the largest slope)")
+
+    @property
+    def law_params(self) -> tuple[float, ...]:
+        """The law's parameters in the kernel's order (contact/laws.py)."""
+        from ..contact.laws import law_params
+
+        return law_params(self)
 
 
 @dataclass(frozen=True)
@@ -171,14 +193,14 @@ class AbradableParams:
 
     enabled: bool = field(default=False, metadata={"doc": "the casing is lined with a coating that wears (the "
                                                           "paper: false, a rigid casing)", "bool": True})
-    yield_force: float = _f(0, lo_open=True, default=100.0,
+    yield_force: float = _f(1e-3, 1e7, default=100.0,
                             doc="a blade tip's normal force at which the liner starts to be removed [N] (a 3D "
                                 "chord pressed uniformly yields at the same total force); default: of the order "
                                 "of the reference rub's own forces, so that it wears (docs/THEORY.md 4.1); a "
                                 "coating's crushing strength times the tip's footprint for a given liner")
-    hardening: float = _f(0, default=0.0, doc="linear hardening: yield force gained per metre removed [N/m] "
-                                               "(0: perfectly plastic)")
-    thickness: float = _f(0, 0.05, lo_open=True, default=2.0e-3,
+    hardening: float = _f(0, 1e10, default=0.0, doc="linear hardening: yield force gained per metre removed [N/m] "
+                                                   "(0: perfectly plastic)")
+    thickness: float = _f(1e-5, 0.05, default=2.0e-3,
                           doc="liner thickness [m]: no wear beyond it (the casing's substrate)")
     n_sectors: int = _f(8, 100000, integer=True, default=720,
                         doc="cells of the liner over the circumference (fixed frame; 720: half a degree)")
@@ -265,6 +287,9 @@ def _check_value(where: str, f: dataclasses.Field, value: Any) -> Any:
             raise ParameterError(f"{where}: expected true or false, got {value!r}")
         return value
     if f.type in ("str", str):
+        choices = meta.get("choices")
+        if choices and value not in choices:
+            raise ParameterError(f"{where}: {value!r} unknown; accepted: {', '.join(choices)}")
         if not isinstance(value, str) or not value:
             raise ParameterError(f"{where}: expected a non-empty string, got {value!r}")
         return value
@@ -379,6 +404,29 @@ def _check_consistency(p: Parameters) -> None:
         raise ParameterError(
             f"contact.chord: {p.contact.chord:g} m out of range; accepted range (0, 2*tip radius={2 * b.tip_radius:g})"
         )
+
+
+def accepted_range(name: str) -> tuple[float, float]:
+    """The accepted closed range [lo, hi] of parameter ``section.field`` (the one declaration, read by the
+    parameter file, the FMUs' variables and the CLI); an open lower end is returned as the value itself (the
+    callers that declare ranges, FMI among them, know only inclusive bounds: they refuse it separately)."""
+    sec, _, fname = name.partition(".")
+    cls = _SECTIONS.get(sec) or _LISTS.get(sec)
+    f = next((f for f in fields(cls) if f.name == fname), None) if cls else None
+    if f is None or "range" not in f.metadata:
+        raise KeyError(f"{name}: no declared range")
+    lo, hi, _ = f.metadata["range"]
+    return lo, hi
+
+
+def describe(name: str) -> str:
+    """The declared description of parameter ``section.field``."""
+    sec, _, fname = name.partition(".")
+    cls = _SECTIONS.get(sec) or _LISTS.get(sec)
+    f = next((f for f in fields(cls) if f.name == fname), None) if cls else None
+    if f is None:
+        raise KeyError(f"{name}: unknown parameter")
+    return f.metadata.get("doc", "")
 
 
 def load_parameters(path: str | Path | None = None) -> Parameters:

@@ -72,7 +72,7 @@ def compute() -> dict[str, np.ndarray]:
         data[f"laws_{f}_q"] = states
         data[f"laws_{f}_force"] = np.array([c.forces(q, speed * w_ref) for q in states])
         data[f"laws_{f}_jac"] = np.array([c.jacobian(q, speed * w_ref) for q in states])
-        data[f"laws_{f}_laws"] = np.array([c.laws(q) for q in states])
+        data[f"laws_{f}_laws"] = np.array([c.laws(q)[:, :7] for q in states])  # the potential (column 8) came later
         outs = [c.outputs(q, speed * w_ref) for q in states]
         data[f"laws_{f}_casing_force"] = np.array([o["casing_force"] for o in outs])
         data[f"laws_{f}_friction_torque"] = np.array([o["friction_torque"] for o in outs])
