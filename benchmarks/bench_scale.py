@@ -38,8 +38,8 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from rotorub_model import build_model, reference_parameters  # noqa: E402
-from rotorub_model.analyses.branch import continue_static  # noqa: E402
-from rotorub_model.analyses.equilibria import Equilibria  # noqa: E402
+from rotorub_model.analyses.continuation.branch import continue_static  # noqa: E402
+from rotorub_model.analyses.continuation.equilibria import Equilibria  # noqa: E402
 from rotorub_model.analyses.linear import run_campbell, run_response  # noqa: E402
 from rotorub_model.analyses.maps import map_row  # noqa: E402
 from rotorub_model.analyses.sweeps import single_threaded  # noqa: E402

@@ -8,9 +8,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rotorub_model.analyses.boundary import BoundaryTracer
-from rotorub_model.analyses.branch import continue_static
-from rotorub_model.analyses.equilibria import Equilibria
+from rotorub_model.analyses.continuation.boundary import BoundaryTracer
+from rotorub_model.analyses.continuation.branch import continue_static
+from rotorub_model.analyses.continuation.equilibria import Equilibria
 from rotorub_model.app.studies import default_grid
 from rotorub_model.structure.model import build_model
 

@@ -6,12 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rotorub_model.analyses.boundary import trace_boundaries
-from rotorub_model.analyses.branch import continue_static
 from rotorub_model.analyses.continuation import agreement
-from rotorub_model.analyses.equilibria import Equilibria
+from rotorub_model.analyses.continuation.boundary import trace_boundaries
+from rotorub_model.analyses.continuation.branch import continue_static
+from rotorub_model.analyses.continuation.equilibria import Equilibria
+from rotorub_model.analyses.continuation.periodic import continue_orbits, continue_orbits_from_hopf, orbit_from_state
 from rotorub_model.analyses.maps import run_stability_map
-from rotorub_model.analyses.periodic import continue_orbits, continue_orbits_from_hopf, orbit_from_state
 from rotorub_model.analyses.transient import run_transient
 from rotorub_model.structure.model import build_model
 
@@ -237,7 +237,7 @@ def test_the_trivial_multiplier_is_the_one_along_the_orbit():
     eigenvector along the flow). Measured on a newcomer's configuration: the trivial one read 1.0000061, the other
     0.999996; removing the one nearest 1 left 1.0000061 and called a stable orbit unstable. Removed by its
     eigenvector instead, the orbit is stable; without a direction the old rule stays."""
-    from rotorub_model.analyses.periodic import MULTIPLIER_TOL, _multipliers
+    from rotorub_model.analyses.continuation.periodic import MULTIPLIER_TOL, _multipliers
 
     rng = np.random.default_rng(3)
     V = rng.standard_normal((6, 6))

@@ -13,11 +13,11 @@ import json
 import numpy as np
 import pytest
 
-from rotorub_model.analyses import branch as branch_mod
-from rotorub_model.analyses.boundary import trace_boundaries
-from rotorub_model.analyses.branch import HOPF_TOL, Branch, continue_static
 from rotorub_model.analyses.continuation import PAPER_SPEED, ContinuationResult, agreement, off_branch, run_continuation
-from rotorub_model.analyses.equilibria import Equilibria
+from rotorub_model.analyses.continuation import branch as branch_mod
+from rotorub_model.analyses.continuation.boundary import trace_boundaries
+from rotorub_model.analyses.continuation.branch import HOPF_TOL, Branch, continue_static
+from rotorub_model.analyses.continuation.equilibria import Equilibria
 from rotorub_model.analyses.linear import run_response
 from rotorub_model.analyses.maps import StabilityMap, run_stability_map
 from rotorub_model.app.cli import build_parser

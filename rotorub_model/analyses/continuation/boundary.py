@@ -53,9 +53,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..stability import RE_TOL
 from .equilibria import Equilibria
 from .roots import illinois
-from .stability import RE_TOL
 
 
 @dataclass

@@ -24,10 +24,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import kernel
-from ..contact import ContactModel, make_contact
-from ..structure.model import Model
-from .static import solve_static
+from ... import kernel
+from ...contact import ContactModel, make_contact
+from ...structure.model import Model
+from ..static import solve_static
 
 
 @dataclass

@@ -28,10 +28,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ParameterError
+from ...errors import ParameterError
+from ..stability import RE_TOL
 from .equilibria import Equilibria, Point
 from .roots import illinois
-from .stability import RE_TOL
 
 # a Hopf point is reported only where its critical eigenvalue's real part is brought below this [1/s]
 HOPF_TOL = 1e-8

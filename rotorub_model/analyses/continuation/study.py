@@ -27,14 +27,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..results import pyplot, save_figure, write_json
-from ..structure.model import Model
+from ...results import pyplot, save_figure, write_json
+from ...structure.model import Model
+from ..maps import StabilityMap
+from ..transient import run_transient
 from .boundary import Curve, nearest_on_polyline, trace_boundaries
 from .branch import Branch, continue_static
 from .equilibria import Equilibria
-from .maps import StabilityMap
 from .periodic import OrbitBranch, continue_orbits, continue_orbits_from_hopf, orbit_from_state
-from .transient import run_transient
 
 FORMULATIONS = ("2D", "3D")
 
@@ -373,7 +373,7 @@ def study_speed(model: Model, speeds: np.ndarray) -> tuple[float, str]:
     lo, hi = float(np.min(speeds)), float(np.max(speeds))
     if lo <= PAPER_SPEED <= hi:
         return PAPER_SPEED, "the paper's speed, on this configuration's grid"
-    from .linear import run_response
+    from ..linear import run_response
 
     crit = run_response(model, lo, hi, 400).critical_speeds
     if len(crit):

@@ -27,9 +27,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ParameterError
+from ...errors import ParameterError
+from ..transient import CentralDifference
 from .equilibria import Equilibria
-from .transient import CentralDifference
 
 MULTIPLIER_TOL = 1e-6  # a multiplier within this of the unit circle is neutral (finite-difference resolution)
 # [m] an "orbit" whose fan disk moves less than this is the static solution (a fixed point of the flow for any
