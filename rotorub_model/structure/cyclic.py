@@ -13,7 +13,7 @@ anisotropic support) simply makes fewer, larger blocks and stays exact.
 Travelling waves rather than cos/sin patterns: a standing pattern of index h is an equal mix of +h and -h,
 seen at two fixed-frame frequencies, and its label would be a coin toss; a wave has one index and one
 fixed-frame frequency. The reference's 38 dofs split into two 7-dof blocks (shaft whirl with the blades'
-index +-1 waves) and blocks of 1 and 2 dofs; tests/test_structure.py checks the blocks' eigenvalues against
+index +-1 waves) and blocks of 1 and 2 dofs; tests/library/test_structure.py checks the blocks' eigenvalues against
 the dense problem.
 """
 

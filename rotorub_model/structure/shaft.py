@@ -21,7 +21,7 @@ Why finite elements: a disk or a bearing between the ends puts a jump in the bea
 force (and, with the disk's tilt inertia, in its bending moment); a global polynomial basis
 converges towards such a shape only like 1/N (with 16 Legendre polynomials the disk-tilt modes
 of the reference rotor were 3-7 % off). Elements with a node at each station represent the
-jumps exactly; the modes then converge like h^4 (tests/test_shaft_fe.py holds them to a
+jumps exactly; the modes then converge like h^4 (tests/library/test_shaft_fe.py holds them to a
 converged reference within 0.5 % for a disk anywhere on the shaft, at rest and at speed).
 
 Dof names: ``shaft.a{i}.x`` / ``shaft.a{i}.y`` — amplitude of Ritz function i along
@@ -35,7 +35,7 @@ import numpy as np
 from .frames import Matrices, axisymmetric_to_rotating, pair_names
 from .params import Parameters
 
-FE_ELEMENTS = 48  # at most L / FE_ELEMENTS between nodes (modes converged to 1e-5, tests/test_shaft_fe.py)
+FE_ELEMENTS = 48  # at most L / FE_ELEMENTS between nodes (modes converged to 1e-5, tests/library/test_shaft_fe.py)
 
 
 def shaft_dof_names(n: int) -> list[str]:

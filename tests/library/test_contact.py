@@ -468,7 +468,7 @@ def test_bad_input(model, args, kwargs, name):
     ("2D", 0.0, 0.0, True), ("3D", np.radians(5.0), 0.2, True), ("3D", np.radians(30.0), 0.05, True),
     ("3D", 0.0, 1e-3, True), ("3D", np.radians(5.0), 0.2, False)])
 def test_kernel_geometry_equals_an_independent_construction(model, form, theta, chord, rotations):
-    """rr_contact_geometry (C) against the numpy construction of tests/reference/geometry.py:
+    """rr_contact_geometry (C) against the numpy construction of tests/library/reference/geometry.py:
     points, normals, tangents and both point-displacement maps, to round-off."""
     from reference.geometry import reference_geometry
 

@@ -1,6 +1,6 @@
-"""Regenerate the golden results the kernel refactor is held to (tests/test_golden.py).
+"""Regenerate the golden results the kernel refactor is held to (tests/library/test_golden.py).
 
-    python tests/golden/make_golden.py            # writes tests/golden/golden.npz
+    python tests/library/golden/make_golden.py    # writes tests/library/golden/golden.npz
 
 What is saved (reference configuration, numbers only, no plots):
 

@@ -1,7 +1,7 @@
 """Every analysis command on a user's configuration (issue 18): more blades, more Ritz functions, the disk
 moved, more friction, a stiffer contact. Each runs end to end through the CLI on small grids; the transient
 point comes from the configuration's own maps (or the command says that none qualifies); the continuation's
-boundary agreement on these configurations is tests/test_continuation_configs.py's."""
+boundary agreement on these configurations is tests/library/test_continuation_configs.py's."""
 
 from __future__ import annotations
 

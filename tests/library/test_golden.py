@@ -1,6 +1,6 @@
 """The compiled kernel is held to the results of the code it replaced.
 
-``tests/golden/golden.npz`` was written by ``tests/golden/make_golden.py`` with the
+``tests/library/golden/golden.npz`` was written by ``tests/library/golden/make_golden.py`` with the
 numba implementation (commit "golden results"), before the C kernel existed. Every
 array recomputed now must equal it to 1e-10 relative to the array's largest magnitude
 (integer and boolean arrays: exactly). Regenerate the file only for an intended change
