@@ -87,17 +87,23 @@ def check_arguments(ns: argparse.Namespace, p) -> None:
     v = getattr(ns, "t_end", None)
     if v is not None and not (math.isfinite(v) and v > 0):
         bad("t-end", v, "(0, inf) s")
+    from ..structure.params import accepted_range
+
+    g0_max = accepted_range("g0_max")[1]
     v = getattr(ns, "g0", None)
-    if v is not None and not (math.isfinite(v) and -p.contact.max_penetration <= v <= 0.1):
-        bad("g0", v, f"[{-p.contact.max_penetration:g}, 0.1] m (down to an interference as deep as "
+    if v is not None and not (math.isfinite(v) and -p.contact.max_penetration <= v <= g0_max):
+        bad("g0", v, f"[{-p.contact.max_penetration:g}, {g0_max:g}] m (down to an interference as deep as "
             "contact.max_penetration)")
-    for name in ("closure", "offset_x", "offset_y"):
+    for name, declared in (("closure", "clearance_closure"), ("offset_x", "casing_offset"),
+                           ("offset_y", "casing_offset")):
         v = getattr(ns, name, None)
-        if v is not None and not (math.isfinite(v) and abs(v) <= 0.01):
-            bad(name.replace("_", "-"), v, "[-0.01, 0.01] m (an engine's closure or casing offset)")
+        lo, hi = accepted_range(declared)
+        if v is not None and not (math.isfinite(v) and lo <= v <= hi):
+            bad(name.replace("_", "-"), v, f"[{lo:g}, {hi:g}] m (an engine's closure or casing offset)")
     v = getattr(ns, "yield_force", None)
-    if v is not None and not (math.isfinite(v) and v > 0):
-        bad("yield-force", v, "(0, inf) N")
+    lo, hi = accepted_range("abradable.yield_force")
+    if v is not None and not (math.isfinite(v) and lo <= v <= hi):
+        bad("yield-force", v, f"[{lo:g}, {hi:g}] N")
     v = getattr(ns, "formulation", None)
     if v is not None and v not in ("2D", "3D"):
         bad("formulation", v, "2D or 3D")

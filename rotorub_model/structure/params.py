@@ -406,10 +406,25 @@ def _check_consistency(p: Parameters) -> None:
         )
 
 
+# The engine's inputs on the casing: not parameter-file fields (they change during a run: the FMUs' inputs, the
+# liner's set_inputs, the CLI's --closure/--offset), declared here once with the fields' ranges. Closure and offset
+# up to 10 mm: an engine's thermal and centrifugal growth and a carcass or manoeuvre load, with margin; a lobe's
+# amplitude likewise; g0's upper end 100 mm (its lower end is -contact.max_penetration: deeper diverges at t = 0).
+INPUT_RANGES: dict[str, tuple[float, float]] = {
+    "clearance_closure": (-0.01, 0.01),   # [m] uniform closure of the clearance (> 0 closes)
+    "casing_offset": (-0.01, 0.01),       # [m] rigid offset of the casing centre, each fixed-frame component
+    "casing_lobe_amplitude": (-0.01, 0.01),  # [m] a_n of the out-of-round casing, n = 2..8
+    "casing_lobe_phase": (-2 * math.pi, 2 * math.pi),  # [rad] psi_n, where lobe n is widest
+    "g0_max": (0.0, 0.1),                 # [m] the largest nominal clearance an FMU or the CLI accepts
+}
+
+
 def accepted_range(name: str) -> tuple[float, float]:
     """The accepted closed range [lo, hi] of parameter ``section.field`` (the one declaration, read by the
     parameter file, the FMUs' variables and the CLI); an open lower end is returned as the value itself (the
     callers that declare ranges, FMI among them, know only inclusive bounds: they refuse it separately)."""
+    if name in INPUT_RANGES:
+        return INPUT_RANGES[name]
     sec, _, fname = name.partition(".")
     cls = _SECTIONS.get(sec) or _LISTS.get(sec)
     f = next((f for f in fields(cls) if f.name == fname), None) if cls else None
