@@ -27,10 +27,10 @@ import numpy as np
 from .compiler import CFLAGS, CompilerError, compile_shared, host_platform_tag, host_suffix
 
 HERE = Path(__file__).resolve().parent
-SOURCES = (HERE / "rotorub_kernel.c",)
+SOURCES = (HERE / "rotorub_kernel.c", HERE / "rr_batch.c")  # rr_batch: the harmonic balance's batch evaluation
 HEADER = HERE / "rotorub_kernel.h"
 MATH_HEADER = HERE / "rr_math.h"  # the elementary functions: the same bits on every platform
-HEADERS = (HEADER, MATH_HEADER)
+HEADERS = (HEADER, MATH_HEADER, HERE / "rr_batch.h")
 ABI_VERSION = 7
 LAW_WIDTH = 7
 OUT_BLADE_BLOCKS = 6
