@@ -76,6 +76,26 @@ class Evaluation:
     Jvp: np.ndarray | None = None  # (m, r, r) P dF/dq' P^T
 
 
+TRUNCATION_WARNING = 1e-2  # the highest harmonic above 1 % of the largest: too few harmonics for this contact
+
+
+class HarmonicsWarning(UserWarning):
+    """Too few harmonics for the contact's kinks: the highest kept harmonic still carries the response."""
+
+
+def check_truncation(problem: HBProblem, Y: np.ndarray) -> str | None:
+    """A stated warning (returned and issued) where the highest harmonic holds more than 1 % of the response."""
+    share = problem.truncation_share(Y)
+    if share <= TRUNCATION_WARNING:
+        return None
+    import warnings
+
+    msg = (f"harmonics: H = {problem.H} is too few for this contact: harmonic {problem.H} still holds "
+           f"{100 * share:.2g} % of the largest (the truncation error is of that order); raise the harmonic count")
+    warnings.warn(msg, HarmonicsWarning, stacklevel=2)
+    return msg
+
+
 class HBProblem:
     """The condensed harmonic balance of one model, contact and casing surface.
 
@@ -84,7 +104,7 @@ class HBProblem:
     """
 
     def __init__(self, model: Model, contact: ContactModel, harmonics: int, samples: int | None = None,
-                 forcing: CasingForcing | None = None, me: float | None = None):
+                 forcing: CasingForcing | None = None, me: float | None = None, external: np.ndarray | None = None):
         self.model, self.contact = model, contact
         self.basis = HarmonicBasis(harmonics, samples)
         self.forcing = forcing if forcing is not None else CasingForcing()
@@ -96,6 +116,11 @@ class HBProblem:
             raise ParameterError(f"harmonics: {harmonics} is fewer than the casing's lobe count {top}: its forcing "
                                  f"(harmonic {top} of the spin) is not represented; accepted: harmonics >= {top} "
                                  f"(>= {4 * top} for a rub: see the convergence study)")
+        # an extra rotating-frame force of the response's period, (2H+1, n) real coefficients (tests, users' loads)
+        self.external = None if external is None else np.asarray(external, dtype=float)
+        if self.external is not None and self.external.shape != (2 * harmonics + 1, model.n_dofs):
+            raise ParameterError(f"external: shape {self.external.shape}; accepted (2 H + 1, n) = "
+                                 f"({2 * harmonics + 1}, {model.n_dofs})")
         self.P = contact_basis(contact)
         self.r = self.P.shape[0]
         self.n = model.n_dofs
@@ -141,6 +166,15 @@ class HBProblem:
             X = np.linalg.solve(Z, np.broadcast_to(self.P.T.astype(complex), (self.H + 1, self.n, self.r)))
             L = self.P[None] @ X
             q_lin = np.linalg.solve(K, m.force(omega, self.me))
+            self._ext = None
+            if self.external is not None:  # its response Z_k^-1 F_k on real coefficients
+                E = self.external
+                Fk = np.concatenate([E[:1].astype(complex), E[1::2] - 1j * E[2::2]])
+                Xe = np.linalg.solve(Z, Fk[..., None])[..., 0]
+                Qe = np.empty_like(E)
+                Qe[0] = Xe[0].real
+                Qe[1::2], Qe[2::2] = Xe[1:].real, -Xe[1:].imag
+                self._ext = Qe
             self._lin = (L, X, q_lin)
             self._lin_key = key
         return self._lin
@@ -195,6 +229,8 @@ class HBProblem:
         f_hat = b.P @ F
         R = Yc - self.apply_L(L, f_hat)
         R[0] -= self.P @ q_lin
+        if self._ext is not None:
+            R -= self._ext @ self.P.T
         Jac = None
         if jacobian:
             D = (self._W @ Jp.reshape(b.m, r * r))
@@ -210,6 +246,8 @@ class HBProblem:
         _, _, q_lin = self.linear(omega, w)
         Y = np.zeros((self.basis.size, self.r))
         Y[0] = self.P @ q_lin
+        if self._ext is not None:
+            Y += self._ext @ self.P.T
         return Y.ravel()
 
     def full(self, Y: np.ndarray, omega: float, w: float, f_hat: np.ndarray | None = None) -> np.ndarray:
@@ -225,7 +263,16 @@ class HBProblem:
         ein = "knv,kv->kn"
         Q[1::2] = np.einsum(ein, Xr, fc) + np.einsum(ein, Xi, fs)
         Q[2::2] = np.einsum(ein, Xr, fs) - np.einsum(ein, Xi, fc)
+        if self._ext is not None:
+            Q += self._ext
         return Q
+
+    def truncation_share(self, Y: np.ndarray) -> float:
+        """The highest kept harmonic's amplitude over the largest oscillating one (contact coordinates): what
+        the truncation leaves out is of this order or below."""
+        a = self.basis.amplitudes(Y.reshape(self.basis.size, self.r))[1:]
+        top = float(np.linalg.norm(a, axis=1).max())
+        return float(np.linalg.norm(a[-1])) / top if top > 0 else 0.0
 
 
 @dataclass

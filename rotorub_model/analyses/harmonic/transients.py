@@ -13,8 +13,9 @@ fan-disk centre, over the last ``window`` revolutions; distances relative to the
 * ``divergent``: the run stopped (penetration beyond contact.max_penetration, or not finite);
 * ``periodic``: consecutive Poincare points within ``tol``;
 * ``period-k`` (k = 2..6): points k revolutions apart within ``tol``, not consecutive ones (a subharmonic);
-* ``settling``: the steps between Poincare points still fall geometrically but were above ``tol`` at the
-  end (too short a run: not marked periodic);
+* ``settling``: the steps between Poincare points still fall (geometrically, or their last third's median
+  below 0.7 of the first third's: an oscillating ring-down) but were above ``tol`` at the end (too short a
+  run: not marked periodic, no amplitude);
 * ``non-periodic``: none of these (quasi-periodic past a Neimark-Sacker point, or chaotic): the map marks it
   and reports no amplitude.
 """
@@ -69,7 +70,8 @@ def classify(poincare: np.ndarray, scale: float, diverged: bool = False, tol: fl
     x = np.arange(s.size)
     slope = np.polyfit(x, s, 1)[0]
     resid = s - np.polyval(np.polyfit(x, s, 1), x)
-    if slope < -0.02 and float(np.std(resid)) < 0.5:
+    early, late = float(np.median(steps[: steps.size // 3])), float(np.median(steps[-(steps.size // 3):]))
+    if (slope < -0.02 and float(np.std(resid)) < 0.5) or late < 0.7 * early:  # a (possibly oscillating) ring-down
         return "settling", spread
     return "non-periodic", spread
 
