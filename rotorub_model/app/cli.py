@@ -302,6 +302,30 @@ def cmd_continuation(ns: argparse.Namespace) -> dict:
     return run_continuation_study(_model(ns), ns.out, speed=ns.speed, maps_dir=ns.maps, quick=ns.quick)
 
 
+@command("forced-response", "forced rub response of a distorted casing over speed: harmonic balance with continuation "
+         "and stability, transients beside it, the interaction map")
+@arg("--speeds", type=float, nargs=2, required=True, metavar=("A", "B"), help="normalised speed range")
+@arg("--formulation", default="2D", help="2D or 3D")
+@arg("--g0", type=float, default=None, help="nominal clearance [m] (default: contact.g0 of the parameter file)")
+@arg("--lobe", type=int, default=None, help="lobe count n >= 2 of the casing's out-of-roundness (1 is the offset)")
+@arg("--amplitude", type=float, default=None, help="the lobe's amplitude a_n [m] (> 0 opens the gap at its maxima)")
+@arg("--phase", type=float, default=0.0, help="fixed-frame angle of a lobe maximum [deg]")
+@arg("--offset-x", type=float, default=None, help="casing centre offset, fixed frame, x [m] (the n = 1 term)")
+@arg("--offset-y", type=float, default=None, help="casing centre offset, fixed frame, y [m]")
+@arg("--harmonics", type=int, default=10, help="harmonics of the spin speed kept (default 10)")
+@arg("--transients", type=int, default=0, help="transients at this many speeds beside the HB (0: none)")
+@arg("--executor", default="process", choices=["process", "serial"], help="where the transients run")
+def cmd_forced_response(ns: argparse.Namespace) -> dict:
+    from .forced_response import forcing_from_args, run_forced_response
+
+    m = _model(ns)
+    g0 = m.params.contact.g0 if ns.g0 is None else ns.g0
+    offset = None if ns.offset_x is None and ns.offset_y is None else (ns.offset_x or 0.0, ns.offset_y or 0.0)
+    f = forcing_from_args(g0, ns.lobe, ns.amplitude, ns.phase, offset)
+    return run_forced_response(m, ns.out, tuple(ns.speeds), ns.formulation, g0, f, ns.harmonics, ns.transients,
+                               executor="serial" if ns.executor == "serial" else None)
+
+
 @command("reproduce", "main job: every analysis of the paper on one configuration, with a summary")
 @arg("--quick", action="store_true", help="coarse grids: a few minutes on 2 cores")
 @arg("--no-fmu", action="store_true", help="library analyses only (no FMU build, harnesses or coupled run)")

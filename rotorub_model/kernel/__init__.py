@@ -28,12 +28,13 @@ from .compiler import CFLAGS, CompilerError, compile_shared, host_platform_tag, 
 
 HERE = Path(__file__).resolve().parent
 # one concern a file (rr_internal.h lists them); the library, both FMUs and the benchmarks compile all of them
+# (rr_batch: the harmonic balance's evaluation of forces and Jacobians at many samples)
 SOURCES = tuple(HERE / f"rr_{name}.c" for name in ("core", "geometry", "laws", "contact", "liner", "cd", "linalg",
-                                                   "static"))
+                                                   "static", "batch"))
 HEADER = HERE / "rotorub_kernel.h"
 INTERNAL_HEADER = HERE / "rr_internal.h"  # declarations shared by the sources, exported by none
 MATH_HEADER = HERE / "rr_math.h"  # the elementary functions: the same bits on every platform
-HEADERS = (HEADER, INTERNAL_HEADER, MATH_HEADER)
+HEADERS = (HEADER, INTERNAL_HEADER, MATH_HEADER, HERE / "rr_batch.h")
 ABI_VERSION = 8
 LAW_WIDTH = 8  # F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction, potential
 OUT_BLADE_BLOCKS = 6

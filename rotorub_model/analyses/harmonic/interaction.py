@@ -1,0 +1,347 @@
+"""Interaction maps: the forced rub response of a distorted casing over a speed range, from the HB continuation
+and from a sweep of transients side by side, with the blade and casing mode crossings k Omega = omega.
+
+Panels: blade-tip amplitude; largest contact force; the casing's incursion (HB: the orbit's deepest
+penetration) and, with the liner, the worn depth of the transients with its lobe count. HB branch: solid
+where stable, dashed where unstable (Floquet multipliers, :mod:`.stability`), folds and changes of stability
+marked. Transients: a filled dot where the run settled on a periodic orbit, a ring for a subharmonic, a cross
+(at the top of the panel) where it did not settle on a periodic orbit (quasi-periodic or chaotic), a red
+triangle where it diverged; such runs report no amplitude (the map marks them instead of pretending).
+
+Crossings: the rotating-frame frequencies of the model without contact (the blades' and the casing ring's, the
+ring seen in the rotating frame as the model holds it) against k Omega for the forced harmonics k; a vertical
+line where they meet (k Omega = omega_mode(Omega)).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from ...contact import make_contact
+from ...errors import ParameterError
+from ...results import legend_outside, pyplot, save_figure, write_json
+from ...structure.model import Model
+from ...structure.params import to_dict
+from ..linear import first_order
+from ..sweeps import run_tasks
+from .continuation import HBBranch, continue_hb
+from .orbit import OrbitView, profile_lobes
+from .problem import HBProblem
+from .surface import CasingForcing
+from .transients import KINDS, forced_transient
+
+
+def mode_crossings(model: Model, speeds: np.ndarray, harmonics: tuple[int, ...], groups=("blades", "casing"),
+                   n_grid: int = 121) -> list[dict]:
+    """Speeds [rad/s] in [speeds.min(), speeds.max()] where k Omega equals a rotating-frame frequency of a mode
+    whose kinetic energy lies mostly in one of ``groups`` (no contact)."""
+    grid = np.linspace(float(np.min(speeds)), float(np.max(speeds)), n_grid)
+    Md = np.diag(model.M)
+    n = model.n_dofs
+    fam = []
+    for om in grid:
+        lam, vec = np.linalg.eig(first_order(model, om))
+        keep = lam.imag > 1e-6
+        lam, vec = lam[keep], vec[:, keep]
+        order = np.argsort(lam.imag)
+        lam, vec = lam[order], vec[:, order]
+        energy = Md[:, None] * np.abs(vec[n:]) ** 2
+        share = {g: energy[model.slices[g]].sum(axis=0) / energy.sum(axis=0) for g in ("shaft", "blades", "casing")}
+        label = [max(share, key=lambda g: share[g][i]) for i in range(lam.size)]
+        fam.append((lam.imag, label))
+    out = []
+    nmode = min(len(f[0]) for f in fam)
+    for k in harmonics:
+        for j in range(nmode):
+            d = np.array([k * om - f[0][j] for om, f in zip(grid, fam)])
+            for i in np.flatnonzero(np.sign(d[1:]) != np.sign(d[:-1])):
+                lab = fam[i][1][j]
+                if lab not in groups:
+                    continue
+                a, b = d[i], d[i + 1]
+                om = grid[i] + (grid[i + 1] - grid[i]) * a / (a - b)
+                out.append({"k": int(k), "mode": j + 1, "group": lab, "omega_rad_s": float(om),
+                            "frequency_rad_s": float(k * om)})
+    return out
+
+
+@dataclass
+class InteractionMap:
+    formulation: str
+    g0: float
+    forcing: CasingForcing
+    harmonics: int
+    omega_ref: float
+    branch: HBBranch
+    hb: dict[str, np.ndarray]  # per HB point: speed, tip, force, disk, incursion, lobes, stable; harmonics (pts, H+1)
+    transients: dict[str, np.ndarray]  # per transient speed: speed, kind, tip, force, wear_depth, wear_lobes
+    crossings: list[dict]
+    timings: dict[str, float] = field(default_factory=dict)
+
+    # ------------------------------------------------------------------ numbers
+    def agreement(self) -> list[dict]:
+        """At each transient speed: the transient's kind and amplitudes, and where it settled periodic, the HB
+        orbit solved at that very speed (Newton from the nearest stable point of the branch) and the relative
+        differences of the blade-tip and fan-disk amplitudes (over max(value, 1e-3 g0): in 2D the blades barely
+        move)."""
+        return list(self.transients.get("agreement", []))
+
+    def summary(self) -> dict:
+        b = self.branch
+        ag = self.agreement()
+        rel = [abs(r["relative_difference"]) for r in ag if "relative_difference" in r]
+        kinds = [KINDS[int(k)] for k in self.transients.get("kind", [])]
+        verdict = (f"{self.formulation}, g0 = {self.g0 * 1e3:.3g} mm: HB branch of {len(b.points)} orbits "
+                   f"({b.message}); "
+                   f"{int(np.sum(~self.hb['stable']))} unstable; {len(b.specials)} special points; transients at "
+                   f"{len(kinds)} speeds: {sum(k == 'periodic' for k in kinds)} periodic, "
+                   f"{sum(k not in ('periodic', 'settling') for k in kinds)} marked not periodic; "
+                   + (f"HB-transient tip amplitude within {100 * max(rel):.2g} % where both are periodic"
+                      if rel else "no speed where both are periodic"))
+        return {"formulation": self.formulation, "g0_m": self.g0, "forcing": self.forcing.summary(),
+                "harmonics": self.harmonics, "omega_ref_rad_s": self.omega_ref, "branch_message": b.message,
+                "points": len(b.points), "specials": [s.summary() for s in b.specials],
+                "hb": {k: v.tolist() for k, v in self.hb.items() if k != "harmonics"},
+                "transients": {k: (v.tolist() if k != "kind" else [KINDS[int(x)] for x in v])
+                               for k, v in self.transients.items() if k != "agreement"},
+                "crossings": self.crossings, "agreement": ag, "timings_s": self.timings, "verdict": verdict}
+
+    # ------------------------------------------------------------------ figures
+    def figure(self):
+        plt = pyplot()
+        wear = "wear_depth" in self.transients
+        fig, axes = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
+        s = self.hb["speed"]
+        st = self.hb["stable"]
+        for ax, key, scale, label in ((axes[0], "tip_amplitude", 1e3, "blade-tip amplitude [mm]"),
+                                      (axes[1], "max_force", 1.0, "largest contact force [N]"),
+                                      (axes[2], "incursion", 1e3, "incursion / wear depth [mm]")):
+            _draw_branch(ax, s, self.hb[key] * scale, st, "HB" + (" incursion" if key == "incursion" else ""))
+            ax.set_ylabel(label)
+            ax.grid(alpha=0.3)
+        for sp in self.branch.specials:
+            i = int(np.argmin(np.abs(s - sp.point.omega / self.omega_ref)))
+            mk = {"fold": "s", "branch": "D", "stability": "o"}[sp.kind]
+            axes[0].plot(sp.point.omega / self.omega_ref, self.hb["tip_amplitude"][i] * 1e3, mk, mfc="none",
+                         color="k", ms=6, label=f"HB {sp.kind}" if sp.kind not in _labelled(axes[0]) else None)
+        tr = self.transients
+        if tr.get("speed") is not None and len(tr["speed"]):
+            kinds = np.array([KINDS[int(k)] for k in tr["kind"]])
+            for ax, key, scale in ((axes[0], "tip_amplitude", 1e3), (axes[1], "max_force", 1.0)):
+                per = kinds == "periodic"
+                ax.plot(tr["speed"][per], tr[key][per] * scale, "o", color="C3", ms=5, label="transient, periodic")
+                sub = np.char.startswith(kinds.astype(str), "period-")
+                if sub.any():
+                    ax.plot(tr["speed"][sub], tr[key][sub] * scale, "o", mfc="none", color="C3", ms=7,
+                            label="transient, subharmonic")
+                top = ax.get_ylim()[1]
+                other = ~per & ~sub & (kinds != "divergent")
+                if other.any():
+                    ax.plot(tr["speed"][other], np.full(other.sum(), top), "x", color="C3", ms=7, clip_on=False,
+                            label="transient not periodic (" + ", ".join(sorted(set(kinds[other]))) + ")")
+                if (kinds == "divergent").any():
+                    ax.plot(tr["speed"][kinds == "divergent"], np.full(int((kinds == "divergent").sum()), top), "^",
+                            color="red", ms=7, clip_on=False, label="transient diverged")
+            if wear:
+                axes[2].plot(tr["speed"], tr["wear_depth"] * 1e3, "v", color="C2", label="transient wear depth")
+                for x, y, lob in zip(tr["speed"], tr["wear_depth"] * 1e3, tr["wear_lobes"]):
+                    if y > 0:
+                        axes[2].annotate(f"{int(lob)}", (x, y), textcoords="offset points", xytext=(0, 5),
+                                         fontsize=7, ha="center", color="C2")
+        for c in self.crossings:
+            x = c["omega_rad_s"] / self.omega_ref
+            for ax in axes:
+                ax.axvline(x, color="0.6" if c["group"] == "blades" else "C4", lw=0.7, ls=":")
+            axes[0].annotate(f"{c['k']}Ω={c['group'][:-1] if c['group'] == 'blades' else 'ring'} {c['mode']}",
+                             (x, 1.0), xycoords=("data", "axes fraction"), rotation=90, fontsize=6, va="top",
+                             ha="right", color="0.4")
+        axes[-1].set_xlabel("spin speed Ω / Ω_ref")
+        f = self.forcing
+        axes[0].set_title(f"Interaction map, {self.formulation}, g0 = {self.g0 * 1e3:.3g} mm, casing "
+                          f"{_forcing_text(f)}, H = {self.harmonics}")
+        for ax in axes:
+            legend_outside(ax)
+        return fig
+
+    def harmonics_figure(self):
+        plt = pyplot()
+        fig, ax = plt.subplots(figsize=(9, 3.6))
+        Hc = self.hb["harmonics"]  # (points, H+1)
+        rel = Hc / np.maximum(Hc.max(axis=1, keepdims=True), 1e-30)
+        s = self.hb["speed"]
+        order = np.argsort(s)
+        im = ax.pcolormesh(s[order], np.arange(Hc.shape[1]), np.log10(np.maximum(rel[order].T, 1e-8)),
+                           shading="nearest", cmap="viridis", vmin=-6, vmax=0)
+        fig.colorbar(im, ax=ax, label="log10 |harmonic| / largest (tip of the most deflected blade)")
+        ax.set_xlabel("spin speed Ω / Ω_ref")
+        ax.set_ylabel("harmonic k of Ω")
+        ax.set_title("Harmonic content of the HB orbits (a branch that folds is drawn where its points fall)")
+        return fig
+
+    def save(self, out: str | Path, stem: str = "interaction_map") -> dict:
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        save_figure(self.figure(), out / f"{stem}.png")
+        save_figure(self.harmonics_figure(), out / f"{stem}_harmonics.png")
+        s = self.summary()
+        write_json(out / f"{stem}.json", s)
+        return s
+
+
+def _labelled(ax) -> set:
+    return {t.replace("HB ", "") for t in ax.get_legend_handles_labels()[1]}
+
+
+def _forcing_text(f: CasingForcing) -> str:
+    parts = []
+    if f.offset_amplitude:
+        parts.append(f"offset {f.offset_amplitude * 1e3:.3g} mm")
+    parts += [f"{n} lobes {a * 1e3:.3g} mm" for n, (a, _) in sorted(f.lobes.items())]
+    return ", ".join(parts) or "round"
+
+
+def _draw_branch(ax, s, y, stable, label):
+    """Stable parts solid, unstable dashed, in the branch's own order (it may fold back)."""
+    first = {True: True, False: True}
+    i0 = 0
+    for i in range(1, len(s) + 1):
+        if i == len(s) or stable[i] != stable[i0]:
+            seg = slice(max(i0 - 1, 0), i)
+            st = bool(stable[i0])
+            ax.plot(s[seg], y[seg], "-" if st else "--", color="C0" if st else "C1", lw=1.4,
+                    label=(f"{label} stable" if st else f"{label} unstable") if first[st] else None)
+            first[st] = False
+            i0 = i
+
+
+def _stable_values_at(s, y, stable, x) -> list[float]:
+    """Values of the stable parts of a (possibly folding) branch at abscissa x (linear between points)."""
+    out = []
+    for i in range(len(s) - 1):
+        a, b = s[i], s[i + 1]
+        if stable[i] and stable[i + 1] and min(a, b) <= x <= max(a, b) and a != b:
+            out.append(float(y[i] + (y[i + 1] - y[i]) * (x - a) / (b - a)))
+    return out
+
+
+def _agreement(problem: HBProblem, branch: HBBranch, tr: dict, omega_ref: float, g0: float) -> list[dict]:
+    from .problem import newton
+    from .stability import monodromy_multipliers
+
+    rows = []
+    pts = [p for p in branch.points if p.stable]
+    floor = 1e-3 * abs(g0)
+    for i, s in enumerate(tr["speed"]):
+        kind = KINDS[int(tr["kind"][i])]
+        row = {"speed": float(s), "transient": kind, "transient_tip_m": float(tr["tip_amplitude"][i]),
+               "transient_disk_m": float(tr["disk_amplitude"][i])}
+        if kind == "periodic" and pts:
+            om = s * omega_ref
+            near = min(pts, key=lambda p: abs(p.omega - om))
+            problem.set_clearance(g0)
+            res = newton(problem, near.Y, om, om)
+            if res.converged:
+                m = OrbitView(problem, res.Y, om, om).measures()
+                fl = monodromy_multipliers(problem, res.Y, om, om)
+                row.update(hb_tip_m=m.tip_amplitude, hb_disk_m=m.disk_amplitude, hb_stable=fl.stable,
+                           tip_relative_difference=(row["transient_tip_m"] - m.tip_amplitude) / max(m.tip_amplitude,
+                                                                                                    floor),
+                           disk_relative_difference=(row["transient_disk_m"] - m.disk_amplitude) / max(
+                               m.disk_amplitude, floor))
+                row["relative_difference"] = max(abs(row["tip_relative_difference"]),
+                                                 abs(row["disk_relative_difference"]))
+        rows.append(row)
+    return rows
+
+
+def hb_measures(problem: HBProblem, branch: HBBranch, omega_ref: float) -> dict[str, np.ndarray]:
+    rows = {k: [] for k in ("speed", "tip_amplitude", "max_force", "disk_amplitude", "incursion", "incursion_lobes",
+                            "stable", "largest_multiplier", "harmonics")}
+    for p in branch.points:
+        problem.set_clearance(p.g0)
+        view = OrbitView(problem, p.Y, p.omega, p.w)
+        m = view.measures()
+        prof = view.incursion_profile()
+        rows["speed"].append(p.omega / omega_ref)
+        rows["tip_amplitude"].append(m.tip_amplitude)
+        rows["max_force"].append(m.max_force)
+        rows["disk_amplitude"].append(m.disk_amplitude)
+        rows["incursion"].append(float(prof.max()))
+        rows["incursion_lobes"].append(profile_lobes(prof)[0])
+        rows["stable"].append(bool(p.stable) if p.stable is not None else True)
+        rows["largest_multiplier"].append(p.floquet.largest if p.floquet is not None else math.nan)
+        rows["harmonics"].append(m.tip_harmonics)
+    out = {k: np.array(v) for k, v in rows.items()}
+    out["stable"] = out["stable"].astype(bool)
+    return out
+
+
+def run_interaction_map(model: Model, formulation: str = "2D", speed_range: tuple[float, float] = (2.5, 4.5),
+                        g0: float | None = None, forcing: CasingForcing | None = None, harmonics: int = 10,
+                        n_transients: int = 9, t_end: float = 20.0, wear: bool = True, executor=None,
+                        progress: bool = True, out: str | Path | None = None) -> InteractionMap:
+    """HB continuation in the spin speed over ``speed_range`` (normalised) and transients at ``n_transients``
+    speeds through the executor (:func:`..sweeps.run_tasks`: process pool, "serial", or a Dask executor)."""
+    lo, hi = (float(v) for v in speed_range)
+    smax = model.params.normalisation.speed_max
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi <= smax):
+        raise ParameterError(f"speed range: [{lo}, {hi}]; accepted 0 < A < B <= {smax:g} (normalised speeds; the "
+                             "model's validity ends at normalisation.speed_max)")
+    if n_transients < 0:
+        raise ParameterError(f"n_transients: {n_transients} out of range; accepted [0, inf)")
+    g0 = model.params.contact.g0 if g0 is None else float(g0)
+    forcing = forcing if forcing is not None else CasingForcing(offset=(0.3 * g0, 0.0))
+    forcing.check(g0)
+    wr = model.params.normalisation.omega_ref
+    contact = make_contact(model, formulation, g0=g0)
+    problem = HBProblem(model, contact, harmonics, forcing=forcing)
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(desc=f"HB continuation {formulation}", unit="orbit", total=None)
+    t0 = time.perf_counter()
+    with threadpool_limits(limits=1):  # small dense algebra: BLAS threads only fight on a shared machine
+        branch = continue_hb(problem, "omega", lo * wr, hi * wr, g0,
+                             progress=(lambda p: bar.update(1)) if bar is not None else None)
+        t_hb = time.perf_counter() - t0
+        hb = hb_measures(problem, branch, wr)
+    if bar is not None:
+        bar.close()
+    t1 = time.perf_counter()
+    tr: dict[str, np.ndarray] = {}
+    if n_transients:
+        speeds = np.linspace(lo, hi, n_transients)
+        pd = to_dict(model.params)
+        payloads = [{"params": pd, "formulation": formulation, "omega": float(s * wr), "g0": g0,
+                     "offset": list(forcing.offset), "lobes": {str(k): list(v) for k, v in forcing.lobes.items()},
+                     "t_end": float(t_end), "wears": False} for s in speeds]
+        res = run_tasks(forced_transient, payloads, executor=executor, progress=progress, desc="transients")
+        tr = {"speed": speeds, "kind": np.array([int(r["kind"]) for r in res]),
+              "spread": np.array([float(r["spread"]) for r in res])}
+        for key in ("tip_amplitude", "max_force", "disk_amplitude", "penetration"):
+            tr[key] = np.array([float(r[key]) if key in r and KINDS[int(r["kind"])] != "divergent" else math.nan
+                                for r in res])
+        # a run that did not settle on a periodic orbit reports no amplitude: the map marks it
+        if wear:
+            for p in payloads:
+                p["wears"] = True
+            resw = run_tasks(forced_transient, payloads, executor=executor, progress=progress, desc="wear transients")
+            tr["wear_depth"] = np.array([float(r.get("wear_depth", math.nan)) for r in resw])
+            tr["wear_lobes"] = np.array([int(r.get("wear_lobes", 0)) for r in resw])
+    t_tr = time.perf_counter() - t1
+    if n_transients:
+        with threadpool_limits(limits=1):
+            tr["agreement"] = _agreement(problem, branch, tr, wr, g0)
+    crossings = mode_crossings(model, np.array([lo, hi]) * wr, tuple(sorted({*forcing.lobe_counts, 1, 2, 3})))
+    result = InteractionMap(formulation, g0, forcing, harmonics, wr, branch, hb, tr, crossings,
+                            {"hb_continuation": t_hb, "transients": t_tr})
+    if out is not None:
+        result.save(out)
+    return result

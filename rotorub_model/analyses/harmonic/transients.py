@@ -1,0 +1,126 @@
+"""Transients of the forced rub response, the independent check of the harmonic balance: one task per speed
+(through the project's executor, :mod:`..sweeps`), and the classifier that says whether a run settled on a
+periodic orbit.
+
+A run starts from the imbalance's static deflection without contact (no ramp: the casing surface acts from
+t = 0) and steps with dt = T / (64 s), T = 2 pi / Omega, s the smallest whole number that keeps dt within half
+the central-difference limit; q is recorded 64 times a revolution, at the frame angles 2 pi i / 64, the
+phases at which the HB orbit is compared sample by sample.
+
+**Settling classifier** (Poincare samples once per revolution, the tip deflections of all blades and the
+fan-disk centre, over the last ``window`` revolutions; distances relative to the orbit's amplitude):
+
+* ``divergent``: the run stopped (penetration beyond contact.max_penetration, or not finite);
+* ``periodic``: consecutive Poincare points within ``tol``;
+* ``period-k`` (k = 2..6): points k revolutions apart within ``tol``, not consecutive ones (a subharmonic);
+* ``settling``: the steps between Poincare points still fall (geometrically, or their last third's median
+  below 0.7 of the first third's: an oscillating ring-down) but were above ``tol`` at the end (too short a
+  run: not marked periodic, no amplitude);
+* ``non-periodic``: none of these (quasi-periodic past a Neimark-Sacker point, or chaotic): the map marks it
+  and reports no amplitude.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+
+import numpy as np
+
+from ...contact import make_contact
+from ...structure.model import Model, build_model
+from ...structure.params import from_dict
+from ..transient import critical_time_step, run_transient
+from .orbit import measures_from_states, profile_lobes, tip_deflection
+from .surface import CasingForcing
+
+SAMPLES_PER_REV = 64
+KINDS = ("periodic", "period-2", "period-3", "period-4", "period-5", "period-6", "settling", "non-periodic",
+         "divergent")
+SETTLE_TOL = 2e-3
+
+
+def classify(poincare: np.ndarray, scale: float, diverged: bool = False, tol: float = SETTLE_TOL,
+             window: int = 24) -> tuple[str, float]:
+    """(kind, spread): the kind of the sequence of Poincare points (K, d) and the relative spread of its last
+    consecutive steps.
+
+    >>> p = np.array([[1.0, 0.0]] * 30)
+    >>> classify(p, 1.0)[0]
+    'periodic'
+    >>> classify(np.array([[(-1.0) ** k, 0.0] for k in range(30)]), 1.0)[0]
+    'period-2'
+    >>> k = np.arange(60) * 2 * np.pi * 0.3819660112501051     # a quasi-periodic circle
+    >>> classify(np.c_[np.cos(k), np.sin(k)], 1.0)[0]
+    'non-periodic'
+    """
+    if diverged or poincare.shape[0] < 8 or not np.all(np.isfinite(poincare)):
+        return "divergent" if diverged or not np.all(np.isfinite(poincare)) else "settling", math.inf
+    P = poincare[-window:]
+    scale = max(scale, 1e-12)
+    steps = np.linalg.norm(np.diff(P, axis=0), axis=1) / scale
+    spread = float(steps[-8:].max())
+    if spread <= tol:
+        return "periodic", spread
+    for k in range(2, 7):
+        if P.shape[0] > 2 * k and float((np.linalg.norm(P[k:] - P[:-k], axis=1) / scale)[-8:].max()) <= tol:
+            return f"period-{k}", spread
+    # still converging: the steps fall geometrically (a straight line of log steps with a negative slope)
+    s = np.log(np.maximum(steps, 1e-300))
+    x = np.arange(s.size)
+    slope = np.polyfit(x, s, 1)[0]
+    resid = s - np.polyval(np.polyfit(x, s, 1), x)
+    early, late = float(np.median(steps[: steps.size // 3])), float(np.median(steps[-(steps.size // 3):]))
+    if (slope < -0.02 and float(np.std(resid)) < 0.5) or late < 0.7 * early:  # a (possibly oscillating) ring-down
+        return "settling", spread
+    return "non-periodic", spread
+
+
+@lru_cache(maxsize=4)
+def _model(key: str) -> Model:
+    import json
+
+    return build_model(from_dict(json.loads(key)))
+
+
+def forced_transient(params: dict, formulation: str, omega: float, g0: float, offset: tuple[float, float],
+                     lobes: dict, t_end: float, wears: bool = False, me: float | None = None) -> dict[str, np.ndarray]:
+    """One speed of the transient sweep (a top-level function of plain data: it pickles to any worker)."""
+    import json
+
+    model = _model(json.dumps(params, sort_keys=True))
+    contact = make_contact(model, formulation, g0=g0)
+    forcing = CasingForcing(offset=tuple(offset), lobes={int(k): tuple(v) for k, v in lobes.items()})
+    liner = forcing.liner(contact, wears=wears, model=model)
+    T = 2 * math.pi / omega
+    cap = 0.5 * critical_time_step(model, contact, omega)
+    s = max(1, math.ceil(T / SAMPLES_PER_REV / cap))
+    dt = T / (SAMPLES_PER_REV * s)
+    n_rev = max(8, int(t_end / T))
+    me_ = model.params.imbalance.me if me is None else me
+    q0 = np.linalg.solve(model.K_omega(omega), model.force(omega, me_))
+    r = run_transient(model, contact, omega, t_end=n_rev * T, t_ramp=0.0, me=me_, dt=dt, record_dt=T / SAMPLES_PER_REV,
+                      q0=q0, liner=liner, wear_record_dt=T * n_rev / 4)
+    K = r.q.shape[0] // SAMPLES_PER_REV
+    out: dict[str, np.ndarray] = {"omega": np.array(omega), "dt": np.array(dt), "t_end": np.array(r.t_end)}
+    if K < 2:
+        out.update(kind=np.array(KINDS.index("divergent")), spread=np.array(math.inf))
+        return out
+    q = r.q[: K * SAMPLES_PER_REV].reshape(K, SAMPLES_PER_REV, -1)
+    v = tip_deflection(model, q[:, -1])
+    d = q[:, -1] @ model.disk_maps[0][:2].T
+    last = slice((K - 1) * SAMPLES_PER_REV, K * SAMPLES_PER_REV)
+    meas = measures_from_states(model, r.q[last], r.outputs["F_N"][last], r.outputs["gap"][last])
+    # distances relative to the orbit's own size in the same coordinates (the last revolution's range)
+    ring = np.hstack([tip_deflection(model, q[-1]), q[-1] @ model.disk_maps[0][:2].T])
+    scale = max(float(np.linalg.norm(np.ptp(ring, axis=0))), 1e-6 * abs(g0), 1e-12)
+    kind, spread = classify(np.hstack([v, d]), scale, r.diverged)
+    out.update(kind=np.array(KINDS.index(kind)), spread=np.array(spread), tip_amplitude=np.array(meas.tip_amplitude),
+               max_force=np.array(meas.max_force), disk_amplitude=np.array(meas.disk_amplitude),
+               penetration=np.array(meas.penetration), last_rev_q=r.q[last], tip_harmonics=meas.tip_harmonics)
+    if wears and r.wear is not None:
+        prof = liner.profile
+        lobes_, amps = profile_lobes(prof)
+        out.update(wear_depth=np.array(float(prof.max())), wear_lobes=np.array(lobes_), wear_harmonics=amps,
+                   wear_profile=prof)
+    return out
