@@ -1,6 +1,6 @@
-"""The FMU side's commands for the ``rotorub`` CLI, found through entry points (the library never imports this
-package): ``build-fmu`` (group ``rotorub.commands``) and the FMU part of ``reproduce`` (group
-``rotorub.reproduce``, fmu_src/harness/reproduce.py)."""
+"""The FMU side's entry points for the ``rotorub`` CLI, found through entry points (the library never imports this
+package): ``build-fmu`` (group ``rotorub.commands``) and the FMU half of ``reproduce`` (group ``rotorub.reproduce``,
+reproduce.py next to this file)."""
 
 from __future__ import annotations
 
@@ -23,32 +23,23 @@ def _add_build_args(sp: argparse.ArgumentParser) -> None:
 
 def build(dest: str | Path, params: str | Path | None = None, native: bool = False, mode: str = "transient",
           platforms: tuple[str, ...] | None = None, fmi3: bool = False) -> dict:
-    """Build one FMU flavour into ``dest`` and write the cross-check kit next to it (``fmi3``: the native FMI 3.0
-    FMU and its kit)."""
+    """Build one flavour of RotorCasingContact.fmu into ``dest`` and write its cross-check kit next to it
+    (``fmi3``: the native FMI 3.0 FMU and its kit)."""
     from rotorub_model.structure.params import load_parameters
 
-    from . import crosscheck
+    from .fmi.compile import NativeBuildError
+    from .models.contact import crosscheck
+    from .models.contact.builder import build_fmu, build_native_fmu
 
     if fmi3 and not native:
-        from .native_fmu import NativeBuildError
-
         raise NativeBuildError("--fmi3: the FMI 3.0 FMU is the native one: add --native (pythonfmu 0.7 writes FMI "
                                "2.0 only)")
-    if fmi3:
-        from .native_fmu3 import build_native_fmu3
-
-        out = build_native_fmu3(dest, params, platforms, mode)
-        kit = crosscheck.write_kit(Path(out["fmu"]).parent, load_parameters(params) if params else None, fmi="3.0")
-        return {**out, "crosscheck_kit": sorted(str(p) for p in kit.values())}
     if native:
-        from .native_fmu import build_native_fmu
-
-        out = build_native_fmu(dest, params, platforms, mode)
+        out = build_native_fmu(dest, params, platforms, mode, fmi="3.0" if fmi3 else "2.0")
     else:
-        from .pythonfmu_fmu import build_fmu
-
         out = build_fmu(dest, params, platforms, mode)
-    kit = crosscheck.write_kit(Path(out["fmu"]).parent, load_parameters(params) if params else None)
+    kit = crosscheck.write_kit(Path(out["fmu"]).parent, load_parameters(params) if params else None,
+                               fmi="3.0" if fmi3 else "2.0")
     return {**out, "crosscheck_kit": sorted(str(p) for p in kit.values())}
 
 
@@ -56,8 +47,8 @@ def _run_build(ns: argparse.Namespace) -> dict:
     from rotorub_model.errors import ParameterError
     from rotorub_model.kernel.compiler import CompilerError
 
-    from .native_fmu import NativeBuildError
-    from .pythonfmu_fmu import BuildError
+    from .fmi.compile import NativeBuildError
+    from .fmi.pythonfmu import BuildError
 
     default = Path("fmus") / (("native-fmi3" if ns.fmi3 else "native") if ns.native else "")
     dest = default if ns.out == "out/build-fmu" else Path(ns.out)
@@ -65,6 +56,15 @@ def _run_build(ns: argparse.Namespace) -> dict:
         return build(dest, ns.params, ns.native, ns.mode, tuple(ns.platforms) if ns.platforms else None, ns.fmi3)
     except (BuildError, NativeBuildError, CompilerError) as exc:
         raise ParameterError(f"build-fmu: {exc}") from None
+
+
+def reproduce_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: str | Path = "fmus",
+                       params_file: str | Path | None = None, progress: bool = True) -> dict:
+    """The FMU half of ``rotorub reproduce`` (reproduce.py): returns ``{"summary": ..., "markdown": ...}``, the
+    additions to the summary and the report's section about them."""
+    from .reproduce import run_fmu_part
+
+    return run_fmu_part(model, out, summary, quick, fmu_dir=fmu_dir, params_file=params_file, progress=progress)
 
 
 # (name, help, add_arguments, run): what rotorub_model.app.cli registers for each entry point

@@ -1,13 +1,15 @@
 """The FMU half of ``rotorub reproduce``: build the FMUs, run the harnesses and the coupled
-engine scenario, and add their results to the library's summary and report.
+engine scenarios, and return their summary and the report's section about them.
 
-Called by :func:`rotorub_model.app.cli.cmd_reproduce` after the library analyses (whose
-summary gives the transient point and the stability grid to compare with).
+Called through the entry point ``rotorub.reproduce`` (cli.py) by :func:`rotorub_model.app.cli.cmd_reproduce`
+after the library analyses (whose summary gives the transient point and the stability grid to compare with);
+the library's report inserts the section as it is (it knows none of the keys here).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -20,9 +22,10 @@ def _step(msg: str) -> None:
 
 def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: str | Path = "fmus",
                  params_file: str | Path | None = None, progress: bool = True) -> dict:
-    """Returns the additions to the summary: harness results, fmu_vs_library_max_rel_diff, coupled_run."""
-    from ..build.commands import build
-    from .analyses import quasi_static_maps, run_up, transient_pair
+    """``{"summary": additions to the summary (harness results, fmu_vs_library_max_rel_diff, coupled_run, ...),
+    "markdown": the report's section about them}``."""
+    from .cli import build
+    from .masters.analyses import compare_flavours, quasi_static_maps, run_up, transient_pair
 
     out = Path(out)
     _step(f"building both FMU flavours (pythonfmu into {fmu_dir}/, native C into {fmu_dir}/native/), with their "
@@ -72,14 +75,12 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
         "eigenvalue real part over the cells where both found the same contact state (cells on another "
         "branch are counted in harnesses.quasi_static.vs_library)")
 
-    try:
-        from ..engine.coupling import run_coupled_scenario
-    except ImportError as exc:  # the engine coupling is part of the package; say so if it is broken
-        raise RuntimeError(f"fmu_src.engine.coupling is not importable: {exc}") from exc
+    from .systems.coupling import run_coupled_scenario
+    from .systems.wear_scenario import run_wear_scenario
+
     _step("coupled engine scenario: LP spool FMU + contact FMU, fmpy master loop, SSP file")
     coupled = run_coupled_scenario(out / "coupled", quick=quick, contact_fmu=fmu, fmu_dir=fmu_dir)
     res["coupled_run"] = coupled
-    from ..engine.wear_scenario import run_wear_scenario
 
     _step("engine scenario with wear: spool + clearance closure + contact with its abradable liner (SSP, three "
           "masters)")
@@ -92,40 +93,85 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
         *[(t, str(Path("coupled") / p)) for t, p in coupled.get("figures", [])],
         *[(t, str(Path("coupled_wear") / p)) for t, p in wear.get("figures", [])],
     ]
-    return res
+    return {"summary": res, "markdown": report_section(res)}
 
 
-def compare_flavours(native: str | Path, pythonfmu: str | Path, model, speed: float, g0: float, out: str | Path,
-                     t_end: float = 3.0, h: float = 1e-3) -> dict:
-    """2D and 3D transients at (speed, g0) through both flavours and in the library (same held inputs):
-    max |F_N difference| / max |F_N| of each pair, and whether the two FMUs agree bit for bit."""
-    from rotorub_model.analyses.transient import run_transient
-    from rotorub_model.contact import make_contact
+# ---------------------------------------------------------------------------------------------- the report's section
+def _fmt(v: Any) -> str:
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    return "–" if v is None else str(v)
 
-    from .analyses import _extract, _rel_diff, run_fmu_transient
 
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    p = model.params
-    omega, me = speed * p.normalisation.omega_ref, p.imbalance.me
+_UNITS = {"mm": "mm", "m": "m", "N": "N", "s": "s", "rad_s": "rad/s", "pct": "%", "kg_m": "kg·m", "N_m": "N·m",
+          "N_m_s": "N·m·s", "J": "J"}
 
-    def me_of_t(t):
-        return me * min(t / 1.0, 1.0)
 
-    s = {"t_end_s": t_end, "h_s": h, "speed": speed, "g0_mm": g0 * 1e3}
-    unzipped = {name: (path, _extract(path, out / f"unzipped_{name}"))
-                for name, path in (("native", native), ("pythonfmu", pythonfmu))}
-    for f in ("2D", "3D"):
-        runs = {name: run_fmu_transient(path, unz, f, g0, lambda _t: omega, me_of_t, t_end, h, p.blades.count,
-                                        name=f"{name}_{f}")
-                for name, (path, unz) in unzipped.items()}
-        lib = run_transient(model, make_contact(model, f, g0=g0), omega, t_end=t_end, t_ramp=1.0, me=me,
-                            record_dt=h, hold=h)
-        a, b = runs["native"].F_N, runs["pythonfmu"].F_N
-        s[f] = {"native_vs_pythonfmu": _rel_diff(a, b), "bit_identical": bool(a.shape == b.shape and
-                                                                            np.array_equal(a, b)),
-                "native_vs_library": _rel_diff(a, lib.outputs["F_N"]),
-                "pythonfmu_vs_library": _rel_diff(b, lib.outputs["F_N"]),
-                "seconds": {k: r.seconds for k, r in runs.items()}}
-    write_json(out / "summary.json", s)
-    return s
+def _label(key: str) -> str:
+    """A summary key as words, its unit suffix in brackets: 'max_friction_torque_N_m' -> 'max friction torque [N·m]'."""
+    for suffix, unit in sorted(_UNITS.items(), key=lambda kv: -len(kv[0])):
+        if key.endswith("_" + suffix):
+            return key[: -len(suffix) - 1].replace("_", " ") + f" [{unit}]"
+    return key.replace("_", " ")
+
+
+def _largest(d: dict | None) -> float | None:
+    return None if not d else max(d.values())
+
+
+def report_section(s: dict) -> str:
+    """The report's markdown about the FMU half's summary ``s`` (what :func:`run_fmu_part` adds to the summary)."""
+    h = s["harnesses"]
+    tr, ru, qs = h["transient"], h["run_up"], h["quasi_static"]
+    rows = [
+        ("transient 2D (section 6), F_N", tr["2D"]["max_rel_diff_F_N_vs_library"],
+         f"diverged: {tr['2D']['diverged']}, blades at 1 s: {tr['2D']['blades_in_contact_at_1s']}"),
+        ("transient 3D (section 6), F_N", tr["3D"]["max_rel_diff_F_N_vs_library"],
+         f"diverged: {tr['3D']['diverged']}, blades at 1 s: {tr['3D']['blades_in_contact_at_1s']}"),
+        ("run-up through the first critical, F_N", ru["max_rel_diff_F_N_vs_library"],
+         f"peak response at Ω = {_fmt(ru['speed_of_peak_response'])}, max F_N {_fmt(ru['max_normal_force_N'])} N"),
+    ]
+    for f, v in qs["vs_library"].items():
+        rows.append((f"quasi-static map {f}, largest real part", v["max_real_max_rel_diff"],
+                     f"{v['cells_same_blades_in_contact']}/{v['cells']} cells same contact state, "
+                     f"{v['cells_other_branch']} on another branch, {v['cells_solved_by_one_only']} solved by one "
+                     f"side only; same stability verdict in {v['same_stability_verdict_fraction']:.0%}"))
+    lines = ["", "## FMU against the library", "",
+             f"Largest relative difference: **{s['fmu_vs_library_max_rel_diff']:.2e}** "
+             f"({s.get('fmu_vs_library_note', '')}).", "",
+             "| harness (through the FMU, fmpy) | max rel. diff vs library | notes |", "|---|---|---|"]
+    lines += [f"| {a} | {b:.2e} | {c} |" for a, b, c in rows]
+    fl = s.get("fmu_flavours")
+    if fl:
+        lines += ["", "## The two FMU flavours on the same scenario", "",
+                  f"Section-6 point, {fl['t_end_s']:g} s, h = {fl['h_s'] * 1e3:g} ms, inputs held over each step "
+                  "(native C FMU, pythonfmu FMU, library `run_transient(hold=h)`).", "",
+                  "| formulation | native vs pythonfmu | bit for bit | native vs library | wall time native / "
+                  "pythonfmu [s] |", "|---|---|---|---|---|"]
+        for f in ("2D", "3D"):
+            v = fl[f]
+            lines.append(f"| {f} | {v['native_vs_pythonfmu']:.1e} | {v['bit_identical']} | "
+                         f"{v['native_vs_library']:.1e} | {v['seconds']['native']:.3f} / "
+                         f"{v['seconds']['pythonfmu']:.3f} |")
+    c = s.get("coupled_run")
+    if c:
+        lines += ["", "## Coupled engine scenario (LP spool FMU + contact FMU)", "",
+                  "| quantity | value |", "|---|---|"]
+        lines += [f"| {_label(k)} | {_fmt(v)} |" for k, v in c.items() if not isinstance(v, dict | list)]
+    w = s.get("coupled_wear_run")
+    if w:
+        lines += ["", "## Engine scenario with wear (spool + clearance closure + contact with its liner)", "",
+                  f"A run-up through the first critical speed with a quarter of the reference imbalance "
+                  f"({w['imbalance_kg_m'] * 1e3:g} kg·mm) and g0 = {w['g0_mm']:g} mm: held at g0 the blades never "
+                  f"touch (wear {w['no_closure_wear_depth_max_mm']:g} mm); the engine's closure (up to "
+                  f"{w['closure_max_mm']:.3g} mm) makes them rub from t = {_fmt(w['t_first_contact_s'])} s and cut "
+                  f"the liner {w['wear_depth_max_mm'] * 1e3:.1f} µm deep ({w['wear_volume_mm3']:.4g} mm³). At the "
+                  f"end the engine keeps {w['clearance_effective_end_mm']:.4g} mm where an unworn liner would leave "
+                  f"{w['clearance_without_wear_end_mm']:.4g} mm: {w['clearance_penalty_mm'] * 1e3:.1f} µm more, "
+                  f"about {w['fuel_burn_penalty_estimate_pct']:.2g} % fuel burn by the rule of thumb "
+                  f"({w['fuel_burn_rule']}). The package runs the same in fmpy, in libcosim (largest relative "
+                  f"difference {_fmt(_largest(w.get('libcosim_max_rel_diff')))}) and in the C master "
+                  f"({_fmt(_largest(w.get('native_host_max_rel_diff')))})."]
+    return "\n".join(lines) + "\n"

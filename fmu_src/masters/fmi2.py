@@ -15,7 +15,7 @@ Two traps of the stack this module exists for:
 
 Example
 -------
->>> from fmu_src.harness.fmi_run import Slave                       # doctest: +SKIP
+>>> from fmu_src.masters.fmi2 import Slave                          # doctest: +SKIP
 >>> with Slave("fmus/RotorCasingContact.fmu", g0=0.2e-3) as s:  # doctest: +SKIP
 ...     s.set(Omega=176.0, imbalance=0.022)
 ...     s.step(0.0, 1e-3)

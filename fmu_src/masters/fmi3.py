@@ -1,13 +1,13 @@
-"""Driving the FMI 3.0 FMU from fmpy (FMU3Slave), and checking it against the FMI 2.0 native FMU.
+"""Driving an FMI 3.0 co-simulation FMU from fmpy (FMU3Slave).
 
 * :class:`Slave3`: one instance, variables by name (an array by its name, all its elements at once), every
   call's status kept instead of raised, the FMU's log captured;
-* :func:`run_kit`: the cross-check kit's run-up (fmu_src/build/crosscheck.py) through the FMI 3.0 FMU, with or
-  without early return, in the kit's FMI 2.0 column names so that one comparison serves both;
-* :func:`first_contact_fmi3`: the first early return of a run, i.e. the first contact the FMU reports;
-* :func:`first_contact_fmi2_bisection`: the first contact of the FMI 2.0 FMU found as a master without events
-  finds it: step until a step ends in contact, roll back to the state before it (fmi2SetFMUstate) and bisect
-  the communication step.
+* :func:`first_event_fmi3`: the first early return of a run (the contact FMU: its first contact);
+* :func:`first_event_fmi2_bisection`: the same event of an FMI 2.0 FMU found as a master without events finds
+  it: step until a step ends past it (an output crosses 0), roll back to the state before it (fmi2SetFMUstate)
+  and bisect the communication step.
+
+The cross-check kit's run through an FMI 3.0 FMU is crosscheck.py's ``run_fmi3``.
 """
 
 from __future__ import annotations
@@ -104,8 +104,8 @@ class Slave3:
         ev, term, early, last = fmi3Boolean(), fmi3Boolean(), fmi3Boolean(), fmi3Float64()
         s = self.call("fmi3DoStep", t, h, fmi3Boolean(True), ctypes.byref(ev), ctypes.byref(term),
                       ctypes.byref(early), ctypes.byref(last))
-        if s <= WARNING:
-            self.t = last.value if early.value else t + h
+        if s <= WARNING:  # an early return, or a step that ended the run, stops at the FMU's last successful time
+            self.t = last.value if early.value or term.value else t + h
         return s, bool(term.value), bool(early.value), float(last.value)
 
     def logged(self, since: int = 0, level: int = ERROR) -> str:
@@ -121,54 +121,9 @@ class Slave3:
         self.free()
 
 
-def kit_columns3(columns: tuple[str, ...]) -> dict[str, tuple[str, int | None]]:
-    """The kit's FMI 2.0 column names -> (FMI 3.0 variable, element index or None): blade[j].F_N is
-    blade.F_N[j] (element j - 1)."""
-    import re
-
-    out: dict[str, tuple[str, int | None]] = {}
-    for c in columns:
-        m = re.match(r"^blade\[(\d+)\]\.(\w+)$", c)
-        out[c] = (f"blade.{m.group(2)}", int(m.group(1)) - 1) if m else (c, None)
-    return out
-
-
-def run_kit(fmu: str | Path, kit: str | Path, early_return: bool = False) -> dict[str, np.ndarray]:
-    """The cross-check kit's run through the FMI 3.0 FMU: inputs of _in.csv held over each step, the outputs
-    after each step (and after initialisation), in the kit's FMI 2.0 column names."""
-    from ..build import crosscheck
-
-    inp = crosscheck.read_csv(Path(kit) / f"{crosscheck.NAME}_in.csv")
-    cols = kit_columns3(crosscheck.OUTPUTS)
-    rows, early_returns = [], 0
-    with Slave3(fmu, early_return=early_return, name="crosscheck3") as s:
-        if s.init(Omega=inp["Omega"][0], imbalance=inp["imbalance"][0]) > WARNING:
-            raise RuntimeError(f"initialisation failed: {s.logged()}")
-
-        def read() -> None:
-            vals = {name: s.get(name) for name in {v for v, _ in cols.values()}}
-            rows.append([vals[v] if k is None else vals[v][k] for v, k in cols.values()])
-
-        read()
-        t = inp["time"]
-        for k in range(len(t) - 1):
-            s.set(Omega=inp["Omega"][k], imbalance=inp["imbalance"][k])
-            h = t[k + 1] - t[k]
-            status, _term, early, last = s.step(h, t[k])
-            while status <= WARNING and early:  # an early return: go on to the communication point
-                early_returns += 1
-                status, _term, early, last = s.step(t[k + 1] - last, last)
-            if status > WARNING:
-                raise RuntimeError(f"step at t = {t[k]}: status {status}: {s.logged()}")
-            read()
-    arr = np.array(rows, dtype=float)
-    return {"time": np.asarray(inp["time"]), **{c: arr[:, i] for i, c in enumerate(crosscheck.OUTPUTS)},
-            "early_returns": np.array(early_returns)}
-
-
-def first_contact_fmi3(fmu: str | Path, h: float, t_end: float, **start) -> dict:
+def first_event_fmi3(fmu: str | Path, h: float, t_end: float, **start) -> dict:
     """Step a fresh instance (early return allowed) at h from the start values ``start`` until its first early
-    return; its time, the steps before it and the FMU's internal substep."""
+    return; its time, the steps before it and the FMU's internal substep (the contact FMU's outputs at it)."""
     with Slave3(fmu, early_return=True, name="first_contact3") as s:
         if s.init(**start) > WARNING:
             raise RuntimeError(s.logged())
@@ -186,22 +141,24 @@ def first_contact_fmi3(fmu: str | Path, h: float, t_end: float, **start) -> dict
     raise RuntimeError(f"no contact before t = {t_end}")
 
 
-def first_contact_fmi2_bisection(fmu: str | Path, h: float, t_end: float, tol: float = 1e-9, **start) -> dict:
-    """The first contact of the FMI 2.0 FMU as a master without events finds it: steps of h, each from a state
-    saved before it (fmi2GetFMUstate), until a step ends with gap_min < 0; then bisection of that communication
-    step with rollbacks (fmi2SetFMUstate): [lo, hi] with no contact after a step of lo and contact after a step
-    of hi, until hi - lo <= tol. Returns t0 + hi (the first time known in contact) and t0 + lo."""
-    from .fmi_run import Slave
+def first_event_fmi2_bisection(fmu: str | Path, h: float, t_end: float, tol: float = 1e-9,
+                               indicator: str = "gap_min", **start) -> dict:
+    """The first time the output ``indicator`` of an FMI 2.0 FMU is below 0, found as a master without events
+    finds it: steps of h, each from a state saved before it (fmi2GetFMUstate), until a step ends with it below 0;
+    then bisection of that communication step with rollbacks (fmi2SetFMUstate): [lo, hi] with the indicator >= 0
+    after a step of lo and < 0 after a step of hi, until hi - lo <= tol. Returns t0 + hi (the first time known
+    past the event) and t0 + lo."""
+    from .fmi2 import Slave
 
     with Slave(fmu, instance_name="bisection2", **start) as s:
         state = s.get_state()
         t = 0.0
         while True:
             s.step(t, h)
-            if s.get("gap_min") < 0.0:
+            if s.get(indicator) < 0.0:
                 break
             if t + h >= t_end:
-                raise RuntimeError(f"no contact before t = {t_end}")
+                raise RuntimeError(f"no event ({indicator} < 0) before t = {t_end}")
             t += h
             s.free_state(state)
             state = s.get_state()
@@ -211,7 +168,7 @@ def first_contact_fmi2_bisection(fmu: str | Path, h: float, t_end: float, tol: f
             s.set_state(state)
             s.step(t, mid)
             trials += 1
-            if s.get("gap_min") < 0.0:
+            if s.get(indicator) < 0.0:
                 hi = mid
             else:
                 lo = mid

@@ -1,9 +1,9 @@
-"""The C hosts (fmu_src/native_host/): compiled for a platform, run where it can run, their CSV read back.
+"""The C hosts (fmu_src/masters/hosts/): compiled for a platform, run where it can run, their CSV read back.
 
 A host compiled for another platform runs here under an emulator when one is installed: ``qemu-aarch64``
 (Debian's qemu-user, with the aarch64 C library of libc6-arm64-cross in /usr/aarch64-linux-gnu) for
 aarch64-linux, ``wine`` for win64. That is how the native FMU's aarch64 and Windows binaries are run here
-and compared with the linux64 one (tests/test_native_fmu.py, benchmarks/cross_platform.py).
+and compared with the linux64 one (tests/fmu/test_binaries.py, benchmarks/cross_platform.py).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-HOST_DIR = Path(__file__).resolve().parent.parent / "native_host"
+HOST_DIR = Path(__file__).resolve().parent / "hosts"
 AARCH64_SYSROOT = Path("/usr/aarch64-linux-gnu")
 
 

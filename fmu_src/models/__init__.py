@@ -1,5 +1,3 @@
-"""The pythonfmu slaves: the contact model (rotorub_casing_contact.py) and the LP spool (spool_slave.py).
-
-Each file is a pythonfmu script that the build stages under a hashed module name; importing them from
-here is only for reading their defaults and interfaces.
-"""
+"""One folder per FMU model (over fmu_src/fmi/ and the library), with the same file names in each: variables.py
+(its one list of variables), model.c and model.h (the model in C), slave.py (its pythonfmu slave, where it has one),
+builder.py, crosscheck.py (its FMI cross-check kit) and FMU.md (its manual)."""

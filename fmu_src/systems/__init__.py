@@ -1,2 +1,2 @@
-"""The engine system: the LP spool FMU, the coupled system's names and connections, its SSP package and a
-fixed-step fmpy master."""
+"""The engine system (over fmu_src/models/ and fmu_src/masters/): the coupled scenarios of the LP spool, the clearance
+closure and the contact FMUs, their SSP packages, and a fixed-step fmpy master loop."""

@@ -1,22 +1,22 @@
 """Engine coupling: the LP spool's speed as a second FMU, the coupled system as an SSP, an fmpy master.
 
-    python -m fmu_src.engine.coupling OUT_DIR [--full] [--contact-fmu F] [--spool-fmu F]
+    python -m fmu_src.systems.coupling OUT_DIR [--full] [--contact-fmu F] [--spool-fmu F]
 
-This module is the master loop and the scenario; the spool FMU is fmu_src/engine/spool.py's, the SSP
-package fmu_src/engine/ssp.py's, what they share fmu_src/engine/system.py's. Pieces:
+This module is the master loop and the scenario; the spool FMU is fmu_src/models/spool/'s, the SSP
+package fmu_src/systems/ssp.py's, what they share fmu_src/systems/system.py's. Pieces:
 
 * :func:`build_native_spool_fmu` builds ``LPSpool.fmu`` in C (the engine system's spool, no Python on
   the host); :func:`build_spool_fmu` the same FMU with pythonfmu (the example of a slave in Python).
   The spool: J dOmega/dt = tau_drive(t) - c_w Omega^2 + friction_torque, with a drive torque schedule
   that makes the rub-free spool follow a half-cosine run-up Omega0 -> Omega1 exactly
-  (fmu_src/engine/spool_interface.py).
+  (fmu_src/models/spool/variables.py).
 * :func:`write_ssp` writes an SSP 1.0 package (a zip): ``SystemStructure.ssd`` naming
   the two FMUs (``resources/RotorCasingContact.fmu`` as component ``contact``,
   ``resources/LPSpool.fmu`` as ``spool``), their connections (spool.Omega ->
   contact.Omega, contact.friction_torque -> spool.friction_torque), units, a default
   experiment, and one SSV parameter set per component (``resources/contact.ssv``,
   ``resources/spool.ssv``). :func:`validate_ssp` checks it against the SSP 1.0 XML
-  schemas (vendored in fmu_src/schemas/ssp1, BSD-2-Clause, see the README there) and
+  schemas (vendored in fmu_src/systems/schemas/ssp1, BSD-2-Clause, see the README there) and
   checks that every connector, connection and parameter exists in the FMUs.
 * :func:`run_coupled` is a fixed-step co-simulation master on fmpy's FMU2Slave.
   Exchange order (Jacobi): at each communication point t_k the inputs of both FMUs
@@ -39,7 +39,7 @@ same in both runs, so the rub run and the rub-free run differ by
 The friction sums are exact (the torques were held over each step); the windage
 integral is a trapezoid rule on the recorded outputs (error O(h^2) of a small term);
 the spool's RK4 error is O(dt^4). The residual is therefore tiny next to the friction
-impulse (tests/test_engine.py states the tolerance).
+impulse (tests/fmu/test_coupling.py states the tolerance).
 """
 
 from __future__ import annotations
@@ -56,9 +56,9 @@ import numpy as np
 
 from rotorub_model.results import pyplot, save_figure, write_json
 
-from ..harness.fmi_run import FMUError, Slave
-from .spool import (  # noqa: F401 - the engine system's API
-    build_contact_fmu,
+from ..masters.fmi2 import FMUError, Slave
+from ..models.contact.builder import build_native_fmu
+from ..models.spool.builder import (  # noqa: F401 - the engine system's API
     build_native_spool_fmu,
     build_spool_fmu,
     spool_defaults,
@@ -84,7 +84,7 @@ def _trapezoid(y: np.ndarray, x: np.ndarray) -> float:
 
 
 class FmuInstance(Slave):
-    """A :class:`~fmu_src.harness.fmi_run.Slave` created uninitialised (logging on, variables by name);
+    """A :class:`~fmu_src.masters.fmi2.Slave` created uninitialised (logging on, variables by name);
     :meth:`initialize` raises :class:`EngineError` when the FMU logs an fmi2Error while
     initializing (pythonfmu reports a refused configuration that way, with fmi2OK)."""
 
@@ -423,8 +423,6 @@ def run_coupled_scenario(out_dir: str | Path, quick: bool = True, contact_fmu: s
     validate the SSP, run the rub-free and the rub cases in the fmpy master loop, the rub case's SSP in libcosim
     and in the C master (no Python in the process), and save ``no_rub.npz``, ``rub.npz``, ``coupled_runup.png``,
     ``summary.json`` in ``out_dir``."""
-    from ..build.native_fmu import build_native_fmu
-
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     cfg = scenario_settings(quick)

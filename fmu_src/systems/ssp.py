@@ -6,11 +6,11 @@
   spool.friction_torque), units, a default experiment, and one SSV parameter set per
   component (``resources/contact.ssv``, ``resources/spool.ssv``).
 * :func:`validate_ssp` checks it against the SSP 1.0 XML schemas (vendored in
-  fmu_src/schemas/ssp1, BSD-2-Clause, see the README there) and checks that every
+  fmu_src/systems/schemas/ssp1, BSD-2-Clause, see the README there) and checks that every
   connector, connection and parameter exists in the FMUs.
 * :func:`run_ssp_libcosim` runs the package as written in libcosim
   (``CosimExecution.from_ssp_file``): a second, independent co-simulation engine.
-* :func:`run_ssp_native` runs it in a process with no Python: fmu_src/native_host/engine_host.c, a
+* :func:`run_ssp_native` runs it in a process with no Python: fmu_src/masters/hosts/engine_host.c, a
   fixed-step C master, given the package's components, parameter sets, connections and step.
 
 The system carries the annotation OpenModelica's OMSimulator reads to know how to run it (type
@@ -28,21 +28,11 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
-from .clearance_interface import MODEL_IDENTIFIER as CLEARANCE_ID
-from .system import (
-    CONNECTIONS,
-    CONTACT_ID,
-    G0_RUB,
-    ME_REF,
-    SPOOL_ID,
-    EngineError,
-    FmuVariable,
-    enumerations,
-    read_description,
-)
+from ..fmi.description import enumerations, read_description
+from ..fmi.variables import Var
+from .system import CLEARANCE_ID, CONNECTIONS, CONTACT_ID, G0_RUB, ME_REF, SPOOL_ID, EngineError
 
-HERE = Path(__file__).resolve().parent.parent  # fmu_src/
-SCHEMA_DIR = HERE / "schemas" / "ssp1"
+SCHEMA_DIR = Path(__file__).resolve().parent / "schemas" / "ssp1"
 NS = {
     "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
     "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon",
@@ -64,7 +54,7 @@ def _fmt(v: float) -> str:
     return repr(float(v))  # shortest round-tripping decimal: a valid xs:double
 
 
-def _connector(parent: ET.Element, var: FmuVariable, kind: str) -> None:
+def _connector(parent: ET.Element, var: Var, kind: str) -> None:
     c = ET.SubElement(parent, _q("ssd", "Connector"), name=var.name, kind=kind)
     attrs = {"unit": var.unit} if (var.type == "Real" and var.unit) else {}
     if var.type == "Enumeration":
@@ -73,7 +63,7 @@ def _connector(parent: ET.Element, var: FmuVariable, kind: str) -> None:
                         else "Real"), attrs)
 
 
-def _parameter_set(name: str, values: dict, variables: dict[str, FmuVariable], units: dict) -> bytes:
+def _parameter_set(name: str, values: dict, variables: dict[str, Var], units: dict) -> bytes:
     root = ET.Element(_q("ssv", "ParameterSet"), version="1.0", name=name)
     params = ET.SubElement(root, _q("ssv", "Parameters"))
     used_units = []
@@ -125,7 +115,7 @@ def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, 
     ``spool_params``). The communication step and the exchange order of
     :func:`run_coupled` are recorded in an annotation of the default experiment.
 
-    With ``clearance_fmu`` (TipClearance.fmu, fmu_src/engine/clearance.py) a third component ``clearance``
+    With ``clearance_fmu`` (TipClearance.fmu, fmu_src/models/clearance/) a third component ``clearance``
     turns the spool's speed into the clearance closure the contact gets (spool.Omega -> clearance.Omega,
     clearance.closure -> contact.clearance_closure), with ``clearance_params`` in ``resources/clearance.ssv``;
     the contact then also shows its wear outputs and the clearance it keeps.
@@ -156,7 +146,7 @@ def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, 
     items = enumerations(croot)
     for pname, value in (("formulation", formulation), ("mode", mode)):
         var = cvars[pname]
-        default = next((n for n, v in items.get(var.declared_type or "", []) if str(v) == var.start), var.start)
+        default = next((n for n, v in items.get(var.declared_type or "", []) if v == var.start), var.start)
         if str(value) != default:
             contact_values[pname] = str(value)
     for k, v in (contact_params or {}).items():
@@ -168,7 +158,7 @@ def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, 
                       description="Low-pressure spool of a turbofan coupled with the blade-tip/casing contact of its "
                                   "fan: the spool's speed drives the contact model, the contact's friction torque "
                                   "brakes the spool",
-                      generationTool="rotorub fmu_src.engine.ssp")
+                      generationTool="rotorub fmu_src.systems.ssp")
     system = ET.SubElement(root, _q("ssd", "System"), name=name)
     elements = ET.SubElement(system, _q("ssd", "Elements"))
     comps = [
@@ -455,7 +445,7 @@ def _ssp_model(z: zipfile.ZipFile, where: Path) -> dict:
 def run_ssp_native(ssp: str | Path, t_end: float, h: float | None = None,
                    record: tuple[tuple[str, str], ...] = (("spool", "Omega"), ("contact", "friction_torque"))
                    ) -> dict[str, np.ndarray]:
-    """Run an SSP package in fmu_src/native_host/engine_host.c: a C process with no Python in it (no libpython
+    """Run an SSP package in fmu_src/masters/hosts/engine_host.c: a C process with no Python in it (no libpython
     loaded, an environment without Python's variables), as a native master would; the Python side only reads
     the package into the host's command line. Jacobi exchange at a fixed step (the package's FixedStepMaster
     step unless ``h`` is given). Returns the time points after each step and the recorded variables
@@ -463,7 +453,7 @@ def run_ssp_native(ssp: str | Path, t_end: float, h: float | None = None,
     import subprocess
     import tempfile
 
-    from ..harness import native_host
+    from ..masters import native_host
 
     host = native_host.cached_host("engine_host.c")
     with tempfile.TemporaryDirectory(prefix="rotorub_ssp_") as tmp, zipfile.ZipFile(ssp) as z:
@@ -506,7 +496,7 @@ def run_ssp_fmpy(ssp: str | Path, t_end: float, h: float | None = None,
 
     from fmpy.fmi1 import FMICallException
 
-    from ..harness.fmi_run import FMUError, Slave
+    from ..masters.fmi2 import FMUError, Slave
 
     with tempfile.TemporaryDirectory(prefix="rotorub_ssp_") as tmp, zipfile.ZipFile(ssp) as z:
         m = _ssp_model(z, Path(tmp))

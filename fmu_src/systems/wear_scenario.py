@@ -1,7 +1,7 @@
 """The engine scenario with wear (issue 19.5): a run-up in which the clearance closes, a rub that wears the
 abradable liner, and the clearance the engine keeps afterwards.
 
-    python -m fmu_src.engine.wear_scenario OUT_DIR [--full]
+    python -m fmu_src.systems.wear_scenario OUT_DIR [--full]
 
 Three native FMUs in one SSP package (``RotorRubEngineWear.ssp``): the LP spool (its speed schedule through
 the first critical speed, as the coupled scenario's), TipClearance (the clearance closure from the spool
@@ -9,7 +9,7 @@ speed: centrifugal at once, thermal with a lag) and RotorCasingContact built wit
 (the reference parameters with ``abradable.enabled = true``: the liner is the FMU's default, so the package
 sets no Enumeration, which libcosim 0.0.6 cannot read). Connections: spool.Omega -> contact.Omega and
 clearance.Omega, clearance.closure -> contact.clearance_closure, contact.friction_torque ->
-spool.friction_torque. The package runs as written in fmpy (:func:`~fmu_src.engine.ssp.run_ssp_fmpy`), in
+spool.friction_torque. The package runs as written in fmpy (:func:`~fmu_src.systems.ssp.run_ssp_fmpy`), in
 libcosim and in the C master (no Python in the process) where they are installed; the summary holds the
 differences between them. The same run without the closure FMU's input (a clearance that stays at g0, the
 liner still abradable) shows what the closure did.
@@ -26,9 +26,10 @@ import numpy as np
 
 from rotorub_model.results import pyplot, save_figure, write_json
 
-from .clearance import build_clearance_fmu
+from ..models.clearance.builder import build_clearance_fmu
+from ..models.contact.builder import build_native_fmu
+from ..models.spool.builder import build_native_spool_fmu
 from .coupling import scenario_settings
-from .spool import build_native_spool_fmu
 from .ssp import run_ssp_fmpy, validate_ssp, write_ssp
 from .system import G0_RUB, EngineError
 
@@ -48,8 +49,6 @@ def build_wear_fmus(fmu_dir: str | Path, platforms: tuple[str, ...] | None = Non
     """The scenario's three native FMUs: the contact FMU with the liner on, the spool, the clearance model
     (its speed input starting at the spool's ``omega0``)."""
     from rotorub_model.structure.params import reference_parameters, to_toml
-
-    from ..build.native_fmu import build_native_fmu
 
     fmu_dir = Path(fmu_dir)
     fmu_dir.mkdir(parents=True, exist_ok=True)

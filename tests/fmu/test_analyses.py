@@ -10,7 +10,7 @@ import pytest
 pytest.importorskip("fmpy", reason="the harnesses drive the FMU with fmpy (pip install -e '.[fmu]')")
 pytest.importorskip("pythonfmu", reason="building the FMU needs pythonfmu (pip install -e '.[fmu]')")
 
-from fmu_src.harness import analyses as harness  # noqa: E402
+from fmu_src.masters import analyses as harness  # noqa: E402
 
 
 @pytest.fixture(scope="module")

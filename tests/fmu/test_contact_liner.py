@@ -9,7 +9,7 @@ import pytest
 fmpy = pytest.importorskip("fmpy", reason="the FMU tests drive the FMU with fmpy (pip install -e '.[fmu]')")
 pytest.importorskip("pythonfmu", reason="building the FMU needs pythonfmu (pip install -e '.[fmu]')")
 
-from fmu_src.harness.fmi_run import Slave  # noqa: E402
+from fmu_src.masters.fmi2 import Slave  # noqa: E402
 from rotorub_model.analyses.transient import run_transient  # noqa: E402
 from rotorub_model.contact import make_contact  # noqa: E402
 from rotorub_model.contact.liner import Liner  # noqa: E402

@@ -3,7 +3,7 @@
 Every comparison runs the same arithmetic on both sides (the pythonfmu FMU carries a copy of
 the library, the native one the same kernel and the same order of operations), so the
 tolerances are round-off, not modelling tolerances. The FMI behaviour a system simulator
-relies on (status codes, refusals, rollback) is tests/test_fmi_behaviour.py's.
+relies on (status codes, refusals, rollback) is tests/fmu/test_fmi2.py's.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import pytest
 fmpy = pytest.importorskip("fmpy", reason="the FMU tests drive the FMU with fmpy (pip install -e '.[fmu]')")
 pytest.importorskip("pythonfmu", reason="building the FMU needs pythonfmu (pip install -e '.[fmu]')")
 
-from fmu_src.harness.fmi_run import FMUError, Slave, simulate  # noqa: E402
+from fmu_src.masters.fmi2 import FMUError, Slave, simulate  # noqa: E402
 from rotorub_model.analyses.stability import stability_of  # noqa: E402
 from rotorub_model.analyses.static import solve_static  # noqa: E402
 from rotorub_model.analyses.transient import critical_time_step, run_transient  # noqa: E402
@@ -235,7 +235,7 @@ BAD_START = [  # (start values, a word the refusal names): refused at the set (n
 def test_bad_parameter_is_an_error_naming_it_and_the_next_instance_works(fmu, unzipped, start, word):
     if "param_file" in start and "param_file" not in {v.name for v in fmpy.read_model_description(unzipped)
                                                       .modelVariables}:
-        pytest.skip("the native FMU has no param_file (tests/test_fmi_behaviour.py checks it is not declared)")
+        pytest.skip("the native FMU has no param_file (tests/fmu/test_fmi2.py checks it is not declared)")
     with pytest.raises(FMUError) as err:
         with Slave(fmu, unzip_dir=unzipped, instance_name="bad", **start) as s:
             s.step(0.0, 1e-3)
@@ -297,7 +297,7 @@ def test_divergence_ends_the_run_and_a_rollback_goes_on(fmu, unzipped, ref_model
             s.step(None, 1e-3)
         assert "ended this simulation" in str(again.value)
         s.set_state(good)  # ... until rolled back to before the divergence
-        # pythonfmu 0.7's binary keeps reporting fmi2Terminated once any step was discarded (fmu_src/FMU.md)
+        # pythonfmu 0.7's binary keeps reporting fmi2Terminated once any step was discarded (contact/FMU.md)
         native = "native" in s.model_description.generationTool
         assert s.terminated() is not native
         s.set(g0=1e-3)
@@ -385,7 +385,7 @@ def test_every_speed_band_of_the_validity_range_steps(fmu, unzipped, formulation
 DANGLING_LOGGER = r'''
 import gc, sys
 import fmpy
-from fmu_src.harness.fmi_run import simulate
+from fmu_src.masters.fmi2 import simulate
 fmu = sys.argv[1]
 simulate(fmu, stop_time=0.01, output_interval=1e-3)
 gc.collect()

@@ -2,9 +2,9 @@
 
 The engine system is the native spool with the native contact FMU (no Python anywhere); the pythonfmu
 spool, the example of a slave in Python, is run with the pythonfmu contact FMU. Both pairs are built once
-from the current sources (conftest's contact FMUs, fmu_src.engine.spool's spool builds) and every physics
+from the current sources (conftest's contact FMUs, fmu_src.models.spool.builder's spool builds) and every physics
 test runs on both.
-The coupled scenario (fmu_src.engine.coupling.scenario_settings(quick=True)): the spool runs up
+The coupled scenario (fmu_src.systems.coupling.scenario_settings(quick=True)): the spool runs up
 from 2.8 to 4.2 x omega_ref (half-cosine, 0.5 s -> 4.5 s) through the first critical
 speed (3.49 x omega_ref) with the reference imbalance 22 kg mm, 3D contact, h = 1 ms,
 once with the rub disabled (g0 = 1 m) and once with g0 = 1 mm.
@@ -27,7 +27,9 @@ pytest.importorskip("lxml")
 from fmpy.fmi1 import FMICallException  # noqa: E402
 from fmpy.validation import validate_fmu  # noqa: E402
 
-from fmu_src.engine.coupling import (  # noqa: E402
+from fmu_src.masters.fmi2 import FMUError  # noqa: E402
+from fmu_src.models.spool.builder import build_native_spool_fmu  # noqa: E402
+from fmu_src.systems.coupling import (  # noqa: E402
     CONNECTIONS,
     EngineError,
     FmuInstance,
@@ -38,12 +40,10 @@ from fmu_src.engine.coupling import (  # noqa: E402
     validate_ssp,
     write_ssp,
 )
-from fmu_src.engine.spool import build_native_spool_fmu  # noqa: E402
-from fmu_src.harness.fmi_run import FMUError  # noqa: E402
 
 CFG = scenario_settings(quick=True)
 SP = CFG["spool_params"]
-J_REF, CW_REF = 55.5, 0.05  # the spool FMU's defaults (fmu_src/engine/spool_interface.py)
+J_REF, CW_REF = 55.5, 0.05  # the spool FMU's defaults (fmu_src/models/spool/variables.py)
 
 
 def schedule(t, w0=SP["Omega0"], w1=SP["Omega1"], t1=SP["t_ramp_start"], T=SP["t_ramp"]):
@@ -111,7 +111,7 @@ def test_both_fmus_pass_fmpy_validation(fmus):
     if fmus["flavour"] == "pythonfmu":  # the script travels under a hashed module name (one sys.modules)
         assert any(n.startswith("resources/lpspool_") and n.endswith(".py") for n in names)
     else:  # C, with its sources, no Python
-        assert "binaries/linux64/LPSpool.so" in names and "sources/spool_model.c" in names
+        assert "binaries/linux64/LPSpool.so" in names and "sources/model.c" in names
 
 
 def test_both_spool_flavours_have_one_interface_and_the_same_numbers(spools):
@@ -325,7 +325,7 @@ def test_bad_input_is_reported_through_fmpy_and_a_new_instance_works(fmus):
     (fmi2Error, the message names it and the range); the pythonfmu one logs it there and refuses the next
     step (its documented limit). The state is kept and the instance, or a new one, goes on."""
     native = fmus["flavour"] == "native"
-    refused = r"J = -1(\.0)? .*out of range; accepted range \[0\.001, (1e\+05|100000\.0)\]"
+    refused = r"J = -1(\.0)? .*out of range; accepted range \[0\.001, 100000(\.0)?\]"
     with pytest.raises(EngineError, match=refused):
         run_coupled(fmus["contact"], fmus["spool"], t_end=0.01, spool_params={"J": -1.0})
     s = FmuInstance(fmus["spool"], "nan_torque")
@@ -368,7 +368,7 @@ def test_ssp_runs_in_libcosim_and_gives_the_fmpy_master_loops_spool_speed(fmus, 
     its spool speed and friction torque are the fmpy loop's (both masters exchange at the communication points
     and hold the inputs over the step)."""
     pytest.importorskip("libcosimpy", reason="libcosimpy: Linux x86_64, Python >= 3.11")
-    from fmu_src.engine.ssp import run_ssp_libcosim
+    from fmu_src.systems.ssp import run_ssp_libcosim
 
     ssp, ref = _rub_ssp(fmus, tmp_path, 1.2)
     lc = run_ssp_libcosim(ssp, 1.2, CFG["h"])
@@ -378,14 +378,14 @@ def test_ssp_runs_in_libcosim_and_gives_the_fmpy_master_loops_spool_speed(fmus, 
 
 
 def test_ssp_runs_in_a_process_with_no_python(fmus, tmp_path):
-    """The package as written, run by a C master (fmu_src/native_host/engine_host.c) in an environment without
+    """The package as written, run by a C master (fmu_src/masters/hosts/engine_host.c) in an environment without
     Python: the native pair gives the fmpy loop's spool speed and friction torque bit for bit (same exchange,
     same FMUs). The pythonfmu pair cannot even load there: its binaries need libpython, which is the point."""
     import sys
 
     if sys.platform != "linux":
         pytest.skip("the C master is run here on Linux")
-    from fmu_src.engine.ssp import run_ssp_native
+    from fmu_src.systems.ssp import run_ssp_native
 
     ssp, ref = _rub_ssp(fmus, tmp_path, 1.2)
     if fmus["flavour"] == "pythonfmu":
@@ -403,7 +403,7 @@ def test_ssd_carries_omsimulators_system_annotation_and_a_proper_name(fmus, tmp_
     fixed-step co-simulation); the system is named for what it is (it was named after a loop variable)."""
     from xml.etree import ElementTree as ET
 
-    from fmu_src.engine.ssp import NS, OMS_NS
+    from fmu_src.systems.ssp import NS, OMS_NS
 
     ssp = write_ssp(tmp_path / "engine.ssp", fmus["contact"], fmus["spool"], h=2e-3)
     assert validate_ssp(ssp) == []

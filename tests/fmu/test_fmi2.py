@@ -5,7 +5,7 @@ only fmi2OK, fmi2Discard (from fmi2DoStep) or fmi2Fatal (an exception escaping t
 where a rule asks for fmi2Error the pythonfmu FMU does the closest thing it can: it logs the
 refusal (status fmi2Error, cause in ``message``) at the call, keeps its state, and refuses the
 next fmi2DoStep with fmi2Discard. Those cases are asserted as they are, with
-``DOCUMENTED_LIMIT`` naming the entry of fmu_src/FMU.md ("What pythonfmu cannot honour").
+``DOCUMENTED_LIMIT`` naming the entry of fmu_src/models/contact/FMU.md ("What pythonfmu cannot honour").
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ from fmpy.fmi2 import (  # noqa: E402
 )
 
 OK, WARNING, DISCARD, ERROR, FATAL = 0, 1, 2, 3, 4
-DOCUMENTED_LIMIT = "fmu_src/FMU.md, section 'What pythonfmu cannot honour'"
+DOCUMENTED_LIMIT = "fmu_src/models/contact/FMU.md, section 'What pythonfmu cannot honour'"
 
 
 @pytest.fixture(scope="module", params=["pythonfmu", "native"])
@@ -214,11 +214,11 @@ def test_quasi_static_build_declares_and_has_its_feedthrough(flavour_qs, tmp_pat
     """Built with mode = quasi_static, the outputs depend on Omega and imbalance, and they are the balanced
     solution at the inputs just set: read before any step, they follow the input."""
     if flavour_qs == "pythonfmu":
-        from fmu_src.build.pythonfmu_fmu import build_fmu
+        from fmu_src.models.contact.builder import build_fmu
 
         fmu = build_fmu(tmp_path / "qs", platforms=("linux64",), mode="quasi_static")["fmu"]
     else:
-        from fmu_src.build.native_fmu import build_native_fmu
+        from fmu_src.models.contact.builder import build_native_fmu
 
         fmu = build_native_fmu(tmp_path / "qs", platforms=("linux64",), mode="quasi_static")["fmu"]
     unz = extract(fmu, str(tmp_path / "qs_unz"))
@@ -663,7 +663,7 @@ def test_a_step_too_long_is_refused_at_once_with_the_longest_allowed(inst, flavo
     cancel. Refused at once, the longest step named, the state left as it was."""
     import time
 
-    from fmu_src.interface import MAX_SUBSTEPS
+    from fmu_src.models.contact.variables import MAX_SUBSTEPS
 
     ref = Inst(inst.f.unzipDirectory, "ref")
     try:
@@ -686,9 +686,9 @@ def test_a_step_too_long_is_refused_at_once_with_the_longest_allowed(inst, flavo
 def test_native_substep_cap_is_the_interfaces():
     from pathlib import Path
 
-    from fmu_src.interface import MAX_SUBSTEPS
+    from fmu_src.models.contact.variables import MAX_SUBSTEPS
 
-    header = (Path(__file__).parents[1] / "fmu_src" / "native" / "fmu_model.h").read_text()
+    header = (Path(__file__).parents[2] / "fmu_src" / "fmi" / "c" / "fmu_model.h").read_text()
     assert f"#define MODEL_MAX_SUBSTEPS {MAX_SUBSTEPS}" in header
 
 
@@ -778,7 +778,7 @@ def test_a_state_of_another_native_fmu_is_refused(unzipped, flavour, tmp_path):
     configured a model from the spool's values. It must be refused as another FMU's, nothing changed."""
     if flavour != "native":
         pytest.skip("the pythonfmu flavour's states are Python objects of its own class")
-    from fmu_src.engine.spool import build_native_spool_fmu
+    from fmu_src.models.spool.builder import build_native_spool_fmu
 
     spool_dir = extract(str(build_native_spool_fmu(tmp_path, platforms=("linux64",))), str(tmp_path / "spool"))
     sp, c = Inst(spool_dir, "spool"), Inst(unzipped, "contact")
@@ -802,7 +802,7 @@ def test_a_state_of_another_native_fmu_is_refused(unzipped, flavour, tmp_path):
 _STATE_BY_VALUE = """
 import ctypes, sys
 sys.path.insert(0, sys.argv[2])
-from test_fmi_behaviour import Inst, START, OK
+from test_fmi2 import Inst, START, OK
 i = Inst(sys.argv[1])
 assert i.init(**START) == OK and i.step() == OK
 state = ctypes.c_void_p()

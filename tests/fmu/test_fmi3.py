@@ -24,7 +24,7 @@ import pytest
 
 fmpy = pytest.importorskip("fmpy")
 
-from fmu_src.harness import fmi3_run  # noqa: E402
+from fmu_src.masters import fmi3 as fmi3_run  # noqa: E402
 
 _why = fmi3_run.fmi3_available()
 if _why:
@@ -32,9 +32,11 @@ if _why:
 
 from fmpy.fmi3 import fmi3Float64, fmi3Int32, fmi3Int64, fmi3UInt64, fmi3ValueReference  # noqa: E402
 
-from fmu_src import interface  # noqa: E402
-from fmu_src.build import crosscheck  # noqa: E402
-from fmu_src.harness.fmi3_run import DISCARD, ERROR, OK, WARNING, Slave3  # noqa: E402
+from fmu_src.fmi.crosscheck import read_csv  # noqa: E402
+from fmu_src.masters import crosscheck as runs  # noqa: E402
+from fmu_src.masters.fmi3 import ERROR, OK, WARNING, Slave3  # noqa: E402
+from fmu_src.models.contact import crosscheck  # noqa: E402
+from fmu_src.models.contact import variables as interface  # noqa: E402
 
 START = {"g0": 0.2e-3, "Omega": 176.2, "imbalance": 0.022}
 DIVERGES = {**START, "max_penetration": 0.2e-3}  # rubs beyond 0.2 mm at about 0.08 s
@@ -55,7 +57,7 @@ def _compiler_or_skip() -> None:
 def built3(tmp_path_factory):
     """`rotorub build-fmu --native --fmi3` (linux64): the FMU and its cross-check kit."""
     _compiler_or_skip()
-    from fmu_src.build.commands import build
+    from fmu_src.cli import build
 
     out = build(tmp_path_factory.mktemp("fmi3"), native=True, fmi3=True, platforms=("linux64",))
     return out
@@ -106,10 +108,11 @@ def test_variables_are_the_fmi2_interface_with_arrays(unzipped3):
     xml = (unzipped3 / "modelDescription.xml").read_text()
     assert 'canGetAndSetFMUState="true"' in xml and 'canSerializeFMUState="true"' in xml
     v3 = {v.name: v for v in md.modelVariables}
+    from fmu_src.fmi.variables import declared, scalars
     from rotorub_model.structure.params import reference_parameters
 
     d = interface.Defaults.from_parameters(reference_parameters())
-    v2 = interface.variables(d, flavour="native")
+    v2 = scalars(declared(interface.variables(d), ("fmi2", "native")))  # the native FMI 2.0 FMU's
     nb = v3["n_blades"]
     assert (nb.type, nb.causality, nb.variability, int(nb.start)) == ("UInt64", "structuralParameter", "fixed", 10)
     for quantity in ("F_N", "F_T", "gap_LE", "gap_TE", "gap_tip", "contact_fraction"):
@@ -139,37 +142,39 @@ def test_variables_are_the_fmi2_interface_with_arrays(unzipped3):
 
 
 def test_sources_binaries_and_the_same_model(unzipped3, native_fmu):
-    from fmu_src.build.binaries import missing_fmi_functions, newest_glibc
+    from fmu_src.fmi.binaries import missing_fmi_functions, newest_glibc
+    from rotorub_model import kernel
 
     src = unzipped3 / "sources"
     bd = (src / "buildDescription.xml").read_text()
-    for f in ("fmi3_cs.c", "fmu_core.c", "contact_model.c", "model_data.c", "rotorub_kernel.c"):
+    kernel_c = [p.name for p in kernel.SOURCES]  # however many files the kernel is split into
+    for f in ("fmi3_cs.c", "fmu_core.c", "model.c", "model_data.c", *kernel_c):
         assert f'<SourceFile name="{f}"/>' in bd and (src / f).is_file()
         assert f in (src / "CMakeLists.txt").read_text()
     so = unzipped3 / "binaries" / "x86_64-linux" / "RotorCasingContact.so"
     assert missing_fmi_functions(so, "3.0") == {"x86_64": []}
     assert newest_glibc(so) <= (2, 17)
     with zipfile.ZipFile(native_fmu) as z:  # one model: the FMI 2.0 FMU's files, byte for byte
-        for f in ("contact_model.c", "fmu_core.c", "fmu_model.h", "rotorub_kernel.c"):
+        for f in ("model.c", "model.h", "variables.h", "fmu_core.c", "fmu_model.h", *kernel_c):
             assert z.read(f"sources/{f}") == (src / f).read_bytes(), f
 
 
 # ------------------------------------------------------------------------------------------ numbers
-def test_kit_run_up_equals_the_fmi2_fmu(built3, fmu3, native_fmu):
+def test_kit_run_up_equals_the_fmi2_fmu(built3, fmu3, native_fmu, tmp_path):
     """The cross-check kit's run-up (through the first critical with rub), same steps, no early return: the
-    FMI 3.0 FMU's outputs are the FMI 2.0 native FMU's to 1e-12 (and its kit, in FMI 3.0 columns, the
-    reference's to the kit's bound)."""
+    FMI 3.0 FMU's outputs are the FMI 2.0 native FMU's (run through the FMI 2.0 kit) to 1e-12, and its kit, in
+    FMI 3.0 columns, the reference's to the kit's bound."""
     kit = Path(built3["fmu"]).parent
-    r3 = fmi3_run.run_kit(fmu3, kit)
-    r2 = crosscheck.run_fmpy(native_fmu, kit)
+    r3 = runs.run_fmi3(fmu3, kit)
+    crosscheck.write_kit(tmp_path)
+    r2 = runs.run_fmpy(native_fmu, tmp_path)
+    col = crosscheck.columns3()
     assert r3["n_contact"].max() >= 1 and r3["gap_min"].min() < 0.0  # it rubs
-    diff = max(float(np.abs(r3[c] - r2[c]).max()) for c in crosscheck.OUTPUTS)
+    diff = max(float(np.abs(r3[col.get(c, c)] - r2[c]).max()) for c in crosscheck.OUTPUTS)
     assert diff <= 1e-12, diff
-    ref = crosscheck.read_csv(kit / f"{crosscheck.NAME}_ref.csv")
+    ref = read_csv(kit / f"{crosscheck.NAME}_ref.csv")
     assert "blade.F_N[1]" in ref and "blade[1].F_N" not in ref
-    for c in crosscheck.OUTPUTS:
-        scale = max(float(np.abs(ref[crosscheck.column3(c)]).max()), 1e-300)
-        assert float(np.abs(r3[c] - ref[crosscheck.column3(c)]).max()) / scale <= 1e-9, c
+    assert max(runs.compare(r3, kit).values()) <= 1e-9
 
 
 def test_a_run_with_early_returns_continues_as_without_to_round_off(unzipped3):
@@ -199,8 +204,8 @@ def test_first_contact_within_one_substep_of_a_bisection_on_the_fmi2_fmu(fmu3, n
     """Early return at the first contact: lastSuccessfulTime is the end of the first internal substep whose state
     is in contact, so a master's bisection of the FMI 2.0 FMU's communication step (rollbacks, to 1e-9 s) finds
     the crossing within that substep: 0 <= t_fmi3 - t_bisection <= dt_internal."""
-    a = fmi3_run.first_contact_fmi3(fmu3, h, 1.0, **START)
-    b = fmi3_run.first_contact_fmi2_bisection(native_fmu, h, 1.0, tol=1e-9, **START)
+    a = fmi3_run.first_event_fmi3(fmu3, h, 1.0, **START)
+    b = fmi3_run.first_event_fmi2_bisection(native_fmu, h, 1.0, tol=1e-9, **START)
     assert a["gap_min"] < 0.0 and a["n_contact"] >= 1
     assert a["t_step"] == pytest.approx(b["t_step"], abs=1e-12) and a["t"] < a["t_step"] + h  # early, same step
     assert 0.0 <= a["t"] - b["t"] <= a["dt_internal"] + 1e-12, (a, b)
@@ -227,7 +232,11 @@ def test_early_return_protocol(unzipped3):
 
 
 # ------------------------------------------------------------------------------------------ divergence, states
-def test_divergence_discards_terminates_and_rolls_back(inst):
+def test_divergence_ends_the_run_with_ok_and_terminate_simulation_and_rolls_back(inst):
+    """FMI 3.0's way to end a run (issue 24.7: fmi3Discard lost fmpy's whole result): the diverging step returns
+    fmi3OK with terminateSimulation = true and lastSuccessfulTime the time the model reached (no early return: it was
+    not allowed), its outputs that state's, the reason logged (a warning) and in 'message'; a further step is
+    refused; a rollback goes on."""
     assert inst.init(**DIVERGES) == OK
     state = ctypes.c_void_p()
     for k in range(2000):
@@ -236,12 +245,13 @@ def test_divergence_discards_terminates_and_rolls_back(inst):
             t_saved = inst.t
         t0 = inst.t
         s, term, early, last = inst.step()
-        if s != OK:
+        assert s == OK
+        if term:
             break
-    assert s == DISCARD and term and not early and t0 <= last <= t0 + 1e-3
+    assert term and not early and t0 < last <= t0 + 1e-3 and inst.get("time") == last
     assert inst.get("status") == 1 and "max_penetration" in inst.get("message")
     assert inst.get("penetration_margin") < 0.0  # the divergence's event indicator crossed 0
-    assert "terminateSimulation = true" in inst.logged(level=DISCARD)
+    assert "terminateSimulation = true" in inst.logged(level=WARNING)
     n = len(inst.messages)
     assert inst.step(1e-3, last)[0] == ERROR and "ended this simulation" in inst.logged(n)
     assert inst.set(Omega=100.0) == ERROR and "roll back with fmi3SetFMUState first" in inst.logged(n)
@@ -252,6 +262,22 @@ def test_divergence_discards_terminates_and_rolls_back(inst):
         s, term, _, _ = inst.step()
         assert s == OK and not term
     assert inst.call("fmi3FreeFMUState", ctypes.byref(state)) == OK
+
+
+def test_divergence_with_early_return_allowed_returns_early_at_the_time_reached(unzipped3):
+    """Early return allowed: the diverging step returns early (FMI 3.0 names terminateSimulation among its
+    reasons), lastSuccessfulTime the substep the divergence was found at, before the communication point (steps of
+    10 ms: 19 substeps each, the divergence found in the 6th)."""
+    with Slave3(None, unzipped=str(unzipped3), early_return=True) as i:
+        assert i.init(**DIVERGES) == OK
+        point, term = 0.0, False
+        while not term and point < 1.0:
+            point += 1e-2
+            while i.t < point and not term:  # on to the communication point after each early return
+                t0 = i.t
+                s, term, early, last = i.step(point - t0, t0)
+                assert s == OK
+        assert term and early and t0 < last < point and i.t == last and i.get("status") == 1
 
 
 def test_serialized_state_continues_bit_for_bit_in_a_fresh_instance(inst):
@@ -418,10 +444,10 @@ def test_every_platform_of_the_fmi2_fmu_in_fmi3_folders(tmp_path):
     """The FMI 2.0 native FMU's platforms and baseline: each binary, in its FMI 3.0 folder, exports the whole FMI
     3.0 API for its architecture and nothing of the kernel; the Linux ones need glibc 2.17 and no libm."""
     pytest.importorskip("ziglang", reason="cross-compiling the FMU needs ziglang (a dependency of rotorub)")
-    from fmu_src.build.binaries import elf_version_needs, exported_symbols, missing_fmi_functions, newest_glibc
-    from fmu_src.build.native_fmu3 import build_native_fmu3
+    from fmu_src.fmi.binaries import elf_version_needs, exported_symbols, missing_fmi_functions, newest_glibc
+    from fmu_src.models.contact.builder import build_native_fmu
 
-    out = build_native_fmu3(tmp_path / "all")
+    out = build_native_fmu(tmp_path / "all", fmi="3.0")
     assert set(out["platforms"]) == {"linux64", "aarch64-linux", "win64", "darwin64", "aarch64-darwin"}
     with zipfile.ZipFile(out["fmu"]) as z:
         z.extractall(tmp_path / "unz")
@@ -469,7 +495,7 @@ def test_rebuilt_with_the_fmus_own_cmakelists_gives_the_same_numbers(fmu3, tmp_p
 # ------------------------------------------------------------------------------------------ found in fmusim 0.0.39
 _STATE_BY_VALUE = """
 import ctypes, sys
-from fmu_src.harness.fmi3_run import Slave3
+from fmu_src.masters.fmi3 import Slave3
 i = Slave3(None, unzipped=sys.argv[1])
 assert i.init(g0=0.2e-3, Omega=176.2, imbalance=0.022) == 0 and i.step()[0] == 0
 state = i.f.getFMUState()
@@ -490,7 +516,7 @@ def test_a_state_freed_by_value_is_freed_with_a_warning_not_a_crash(unzipped3):
     import sys
 
     r = subprocess.run([sys.executable, "-c", _STATE_BY_VALUE, str(unzipped3)], capture_output=True, text=True,
-                       timeout=60, cwd=str(Path(__file__).resolve().parents[1]))
+                       timeout=60, cwd=str(Path(__file__).resolve().parents[2]))
     assert r.returncode == 0, r.stderr[-2000:]
     out = dict(line.split(" ", 1) for line in r.stdout.splitlines())
     assert out["status"] == str(OK) and out["step"] == str(OK)  # OK: fmusim ends its run at any other status

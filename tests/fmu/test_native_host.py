@@ -1,6 +1,6 @@
 """Both flavours of RotorCasingContact.fmu outside fmpy: a native C host and OSP libcosim (libcosimpy).
 
-* fmu_src/native_host/fmu_host.c, compiled with gcc, is a master that is not Python: it dlopens the FMU's
+* fmu_src/masters/hosts/fmu_host.c, compiled with gcc, is a master that is not Python: it dlopens the FMU's
   binaries/linux64/RotorCasingContact.so and calls the FMI 2.0 functions itself. The native FMU needs nothing
   else (the host's environment has no Python in it); the pythonfmu one needs libpython (LD_PRELOAD, or the
   host's -L option: dlopen RTLD_GLOBAL) and PYTHONHOME / PYTHONPATH (see docs/FMU-hosts.md).
@@ -27,8 +27,8 @@ from xml.etree import ElementTree
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-HOST_C = ROOT / "fmu_src" / "native_host" / "fmu_host.c"
+ROOT = Path(__file__).resolve().parents[2]
+HOST_C = ROOT / "fmu_src" / "masters" / "hosts" / "fmu_host.c"
 MODEL = "RotorCasingContact"
 N_BLADES = 10
 # a short transient run with contact from the first steps (3D, reference model, 0.2 mm clearance)

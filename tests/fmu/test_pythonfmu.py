@@ -1,7 +1,7 @@
 """Processes that used an FMU exit cleanly (benchmarks/bench_exit.py, a small N here; 200 + 200 in the README).
 
 The cause of the aborts seen before (pythonfmu 0.7.0's linux64 binary writes into a block it freed, at
-process exit) is removed at build time by patching one instruction (fmu_src/build/pythonfmu_fmu.py); the first test
+process exit) is removed at build time by patching one instruction (fmu_src/fmi/pythonfmu.py); the first test
 checks the patch is in the built FMU, the others run fresh processes of both kinds for both flavours.
 """
 
@@ -16,11 +16,12 @@ import pytest
 
 pytest.importorskip("fmpy")
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_the_pythonfmu_binary_is_patched(contact_fmu):
-    from fmu_src.build.pythonfmu_fmu import _ON_UNLOAD_BYTES, _ON_UNLOAD_OFFSET
+    from fmu_src.fmi.pythonfmu import ON_UNLOAD_BYTES as _ON_UNLOAD_BYTES
+    from fmu_src.fmi.pythonfmu import ON_UNLOAD_OFFSET as _ON_UNLOAD_OFFSET
 
     with zipfile.ZipFile(contact_fmu) as z:
         so = z.read("binaries/linux64/RotorCasingContact.so")

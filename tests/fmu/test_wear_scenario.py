@@ -13,12 +13,12 @@ fmpy = pytest.importorskip("fmpy", reason="the engine tests drive the FMUs with 
 
 from fmpy.validation import validate_fmu  # noqa: E402
 
-from fmu_src.engine import clearance_interface as ci  # noqa: E402
-from fmu_src.engine.clearance import build_clearance_fmu  # noqa: E402
-from fmu_src.engine.ssp import ssp_contents, validate_ssp  # noqa: E402
-from fmu_src.engine.system import G0_RUB  # noqa: E402
-from fmu_src.engine.wear_scenario import build_wear_fmus, run_wear_scenario  # noqa: E402
-from fmu_src.harness.fmi_run import Slave  # noqa: E402
+from fmu_src.masters.fmi2 import Slave  # noqa: E402
+from fmu_src.models.clearance import variables as ci  # noqa: E402
+from fmu_src.models.clearance.builder import build_clearance_fmu  # noqa: E402
+from fmu_src.systems.ssp import ssp_contents, validate_ssp  # noqa: E402
+from fmu_src.systems.system import G0_RUB  # noqa: E402
+from fmu_src.systems.wear_scenario import build_wear_fmus, run_wear_scenario  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -91,7 +91,7 @@ def test_the_clearance_starts_warm_at_the_spools_initial_speed_in_every_master(f
     propagates the connections' initial values (OMSimulator and libcosim do), so a package whose spool starts at
     170 rad/s, not the clearance FMU's declared 149.52, starts warm at 170: closure c_c 170^2 + c_t 170^2 after
     the first step (before, the declared start was used whatever the package said, found in OMSimulator)."""
-    from fmu_src.engine.ssp import run_ssp_fmpy, run_ssp_libcosim, run_ssp_native, write_ssp
+    from fmu_src.systems.ssp import run_ssp_fmpy, run_ssp_libcosim, run_ssp_native, write_ssp
 
     w0 = 170.0
     ssp = write_ssp(tmp_path / "warm.ssp", fmus["contact"], fmus["spool"], clearance_fmu=fmus["clearance"],

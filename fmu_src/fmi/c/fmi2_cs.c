@@ -1,6 +1,6 @@
 /*
  * fmi2_cs.c: the FMI 2.0 co-simulation interface around a model (fmu_model.h), model-agnostic: the same file
- * builds RotorCasingContact, LPSpool and TipClearance. A thin layer over fmu_core.c (shared with the FMI 3.0
+ * builds every model of fmu_src/models/. A thin layer over fmu_core.c (shared with the FMI 3.0
  * wrapper, fmi3_cs.c): FMI 2.0's names, callbacks and types, and its calling sequence.
  *
  * What a system simulator can rely on (fmu_core.c says the rest):
@@ -28,7 +28,7 @@ typedef struct {
 
 static const core_dialect FMI2 = {0x52524632u /* "RRF2" */, "fmi2SetFMUstate", "fmi2Reset", "fmi2Terminate",
                                   "fmi2FreeInstance", "fmi2EnterInitializationMode", "fmi2ExitInitializationMode",
-                                  "fmi2Terminated", 0};
+                                  "fmi2Terminated", 0, 0};
 
 #define MSG_LEN CORE_MSG_LEN
 #define VAR(vr) CORE_VAR(vr)

@@ -1,17 +1,22 @@
 /*
  * fmi3_cs.c: the FMI 3.0 co-simulation interface around a model (fmu_model.h), the same model, values and rules
  * as the FMI 2.0 wrapper (fmi2_cs.c): both are thin layers over fmu_core.c. What FMI 3.0 adds here:
- *   - arrays: an FMI 3.0 variable is a run of the model's FMI 2.0 value slots (fmi3_vars.h), so the blades'
- *     forces and gaps are arrays of n_blades (a structural parameter fixed by the build); nValues must be the
- *     number of elements of the value references given, or the call is refused with nothing stored;
+ *   - arrays: an FMI 3.0 variable is a run of the model's FMI 2.0 value slots (fmi3_vars.h), its size fixed by
+ *     the build (a structural parameter, or a number); nValues must be the number of elements of the value
+ *     references given, or the call is refused with nothing stored;
  *   - Enumerations are read and written with fmi3GetInt64 / fmi3SetInt64, as the standard says;
- *   - early return: instantiated with earlyReturnAllowed, fmi3DoStep ends at the first internal substep that
- *     brings a blade into contact from a state without contact (the event indicator gap_min crossing 0
- *     downwards), with earlyReturn = true and lastSuccessfulTime that substep's end; without it, every step is
- *     the FMI 2.0 FMU's, bit for bit. No event mode (hasEventMode = false): a contact changes no discrete
- *     state, there is nothing for an event mode to update;
- *   - the divergence rule of the FMI 2.0 FMU: the step that diverges returns fmi3Discard with
- *     terminateSimulation = true; fmi3SetFMUState to an earlier state (or fmi3Reset) goes on.
+ *   - early return: instantiated with earlyReturnAllowed, fmi3DoStep ends at the model's first event inside the
+ *     step (model_step_to_event; the contact model: the first internal substep that brings a blade into contact
+ *     from a state without contact), with earlyReturn = true and lastSuccessfulTime that substep's end; without
+ *     it, every step is the FMI 2.0 FMU's, bit for bit. No event mode (hasEventMode = false): the models' events
+ *     change no discrete state, there is nothing for an event mode to update;
+ *   - the divergence rule in FMI 3.0's terms: the step that diverges (or finds no balanced solution) returns fmi3OK
+ *     with terminateSimulation = true, lastSuccessfulTime the time the model reached and, when early return is
+ *     allowed and that time is before the communication point, earlyReturn = true; its outputs are those of the
+ *     state reached. FMI 3.0's fmi3Discard would say "nothing changed, the output arguments are undefined", which
+ *     is not what happened, and fmpy's FMI 3.0 loop raises on it (the user loses every row). fmi3SetFMUState to an
+ *     earlier state (or fmi3Reset) goes on; a further step without that is fmi3Error. (The FMI 2.0 FMU keeps
+ *     fmi2Discard, then fmi2Terminated, as FMI 2.0 asks.)
  * Every misuse is fmi3Error with a logged message naming the variable, the value and the accepted range or
  * the rule, the instance left as it was.
  */
@@ -34,7 +39,7 @@ typedef struct {
 
 static const core_dialect FMI3 = {0x52524633u /* "RRF3" */, "fmi3SetFMUState", "fmi3Reset", "fmi3Terminate",
                                   "fmi3FreeInstance", "fmi3EnterInitializationMode", "fmi3ExitInitializationMode",
-                                  "terminateSimulation", 1};
+                                  "terminateSimulation", 1, 1};
 
 static const char *const TYPE_NAME[] = {"Float64", "Int32", "UInt64", "Enumeration", "String"};
 static const char *const ACCESS[] = {"fmi3GetFloat64/fmi3SetFloat64", "fmi3GetInt32/fmi3SetInt32",
@@ -90,7 +95,7 @@ static fmi3Status resolve(inst_t *c, const char *fn, v3_type want, const fmi3Val
     }
     if (total != n_values)
         return FAIL(c, "%s: nValues = %zu, but the %zu value reference(s) given have %zu element(s) (an array of "
-                    "n_blades counts each element)", fn, n_values, nvr, total);
+                    "its size counts each element)", fn, n_values, nvr, total);
     return fmi3OK;
 }
 
@@ -193,8 +198,8 @@ static fmi3Status check_set(inst_t *c, const char *fn, const fmi3_var *v, const 
             return FAIL(c, "%s: %s is a structural parameter: set only in configuration mode "
                         "(fmi3EnterConfigurationMode from the instantiated state)", fn, v->name);
         if (x[0] != (double)v->fixed)
-            return FAIL(c, "%s: %s = %s out of range; accepted range [%llu, %llu] (the blade count is built into the "
-                        "FMU: rebuild with another parameter file, rotorub build-fmu --native --fmi3 --params FILE)", fn,
+            return FAIL(c, "%s: %s = %s out of range; accepted range [%llu, %llu] (fixed when the FMU was built: "
+                        "rebuild it for another value, as its manual documentation/FMU.md says)", fn,
                         v->name, core_num(x[0], b, sizeof b), v->fixed, v->fixed);
         return fmi3OK;
     }
@@ -256,7 +261,7 @@ fmi3Status fmi3SetInt64(fmi3Instance instance, const fmi3ValueReference valueRef
 fmi3Status fmi3SetUInt64(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
                          const fmi3UInt64 values[], size_t nValues)
 {
-    SET_VALUES("fmi3SetUInt64", V3_UINT64, store_int) /* nothing is stored: the only UInt64 is n_blades, fixed */
+    SET_VALUES("fmi3SetUInt64", V3_UINT64, store_int) /* nothing is stored: a UInt64 is a structural parameter, fixed */
 }
 
 fmi3Status fmi3SetString(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
@@ -403,8 +408,8 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
     }
     if (eventModeUsed) {
         refuse_instance(logMessage, instanceEnvironment, "fmi3InstantiateCoSimulation: eventModeUsed = true, but this "
-                        "FMU has no event mode (hasEventMode = false: a contact changes no discrete state); "
-                        "instantiate with eventModeUsed = false, and earlyReturnAllowed = true to land on contacts");
+                        "FMU has no event mode (hasEventMode = false: its events change no discrete state); "
+                        "instantiate with eventModeUsed = false, and earlyReturnAllowed = true to land on its events");
         return NULL;
     }
     c = (inst_t *)calloc(1, sizeof *c);
@@ -490,7 +495,7 @@ fmi3Status fmi3EnterEventMode(fmi3Instance instance)
 {
     CHECK_INSTANCE(instance, "fmi3EnterEventMode");
     return FAIL(instance, "fmi3EnterEventMode: this FMU has no event mode (hasEventMode = false); with "
-                "earlyReturnAllowed, fmi3DoStep returns early at a contact instead");
+                "earlyReturnAllowed, fmi3DoStep returns early at the model's events instead");
 }
 
 fmi3Status fmi3Terminate(fmi3Instance instance)
@@ -613,7 +618,7 @@ fmi3Status fmi3GetAdjointDerivative(fmi3Instance instance, const fmi3ValueRefere
     return FAIL(instance, "fmi3GetAdjointDerivative: not provided (providesAdjointDerivatives = false)");
 }
 
-/* Configuration mode exists for the structural parameter n_blades, which the build fixes: it may be set to its
+/* Configuration mode exists for the structural parameters (an array's size), which the build fixes: one may be set to its
  * one value there (a master that sets every structural parameter it reads goes through), nothing else. */
 fmi3Status fmi3EnterConfigurationMode(fmi3Instance instance)
 {
@@ -856,12 +861,17 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
         s = (fmi3Status)core_step(&c->core, "fmi3DoStep", currentCommunicationPoint, communicationStepSize,
                                   c->early_return ? model_step_to_event : NULL, &early);
     *eventHandlingNeeded = fmi3False; /* no event mode: nothing to update */
-    *earlyReturn = early ? fmi3True : fmi3False;
     *terminateSimulation = c->core.stopped ? fmi3True : fmi3False;
     *lastSuccessfulTime = c->core.last_good;
-    if (early) {
+    /* an early return at the model's event, or one that ends the run before the communication point (FMI 3.0 names
+     * terminateSimulation among the reasons for an early return; without it allowed, the master stamps the row) */
+    if (s == fmi3OK && c->core.stopped && c->early_return &&
+        c->core.last_good < currentCommunicationPoint + communicationStepSize)
+        early = 1;
+    *earlyReturn = early ? fmi3True : fmi3False;
+    if (early && !c->core.stopped) {
         char bt[32];
-        core_debug(&c->core, "fmi3DoStep: first contact at t = %s s: early return", core_num(c->core.time, bt, sizeof bt));
+        core_debug(&c->core, "fmi3DoStep: the model's event at t = %s s: early return", core_num(c->core.time, bt, sizeof bt));
     }
     return s;
 }

@@ -1,9 +1,9 @@
 /*
  * fmi3_vars.h: the FMI 3.0 variables of a model, as runs of the FMI 2.0 value slots its model works on
- * (fmu_model.h): a scalar is one slot, an array (the blades' forces and gaps, the wear harmonics) the slots of
- * its elements in order. `rotorub build-fmu --native --fmi3` generates the table (FMI3_INFO) next to
- * MODEL_INFO from the same interface (fmu_src/build/native_fmu3.py), so the two FMUs share every range,
- * start value and rule, and the model is the same file.
+ * (fmu_model.h): a scalar is one slot, an array the slots of its elements in order. The build generates the table
+ * (FMI3_INFO, fmu_src/fmi/csource.py) next to MODEL_INFO from the same variable list (a model's variables.py),
+ * so the FMI 2.0 and 3.0 FMUs of a model share every range, start value and rule, and the model is the same
+ * file.
  */
 #ifndef ROTORUB_FMI3_VARS_H
 #define ROTORUB_FMI3_VARS_H

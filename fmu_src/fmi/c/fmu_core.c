@@ -6,11 +6,13 @@
  *     range or the rule (never a silent OK, never Fatal, never a crash), and leaves the instance as it was;
  *   - configuration errors are reported when initialisation ends (the parameters can be corrected and the
  *     call repeated);
- *   - a step the model cannot complete (a divergence, a spool that stops, no balanced solution) is Discard
- *     with the reason in the log and in 'message'; from then on the run has ended (fmi2Terminated,
- *     terminateSimulation) at the last successful time, so that every master ends it cleanly with what it
- *     has. The flag belongs to the FMU state: restoring a state saved before the step (or a reset) clears it;
- *     a further step without that is an error;
+ *   - a step the model cannot complete (a divergence, a speed that would fall below 0, no balanced solution) ends the run at
+ *     the last successful time, with the reason in the log and in 'message': FMI 2.0 fmi2Discard then
+ *     fmi2Terminated; FMI 3.0 fmi3OK with terminateSimulation (the dialect's end_run_with_ok), so that every
+ *     master ends it cleanly with what it has. The flag belongs to the FMU state: restoring a state saved
+ *     before the step (or a reset) clears it; a further step without that is an error;
+ *   - a serialized state carries a checksum of every byte: a state changed anywhere after serialisation is
+ *     refused, as a state of another FMU or build is;
  *   - a state can be restored in every phase, the instantiated one included: a state saved during a run is
  *     restored with its model (configured from the state's own parameters);
  *   - errors and warnings reach the logger whether or not logging was switched on (debug messages only when
@@ -23,6 +25,39 @@
 #include <string.h>
 
 #include "fmu_core.h"
+#include "model.h"
+
+/* ------------------------------------------------------------------ what a model need not write */
+
+#ifndef MODEL_HAS_CHECK_SET
+model_status model_check_set(const model_runtime *m, const model_values *v, int vr, double x, char *msg, size_t len)
+{
+    (void)m;
+    (void)v;
+    (void)vr;
+    (void)x;
+    (void)msg;
+    (void)len;
+    return MODEL_OK; /* the declared ranges are the only rules */
+}
+#endif
+
+#ifndef MODEL_HAS_STEP_TO_EVENT
+model_status model_step_to_event(model_runtime *m, model_values *v, double t, double h, int *event, char *msg,
+                                 size_t len)
+{
+    *event = 0; /* a model without events: every step is model_step's */
+    return model_step(m, v, t, h, msg, len);
+}
+#endif
+
+#ifndef MODEL_HAS_TIME_ADVANCED
+double model_time_advanced(const model_runtime *m)
+{
+    (void)m;
+    return 0.0; /* a refused step leaves the state as it was */
+}
+#endif
 
 const char *const CORE_PHASE_NAME[] = {"instantiated", "initialization mode", "step mode", "terminated"};
 
@@ -48,10 +83,19 @@ typedef struct {
 
 const char *core_num(double x, char *buf, size_t len)
 {
-    int p;
+    int p, e;
+    const char *exp_at;
+    double a = fabs(x);
     for (p = 1; p <= 17; ++p) {
         snprintf(buf, len, "%.*g", p, x);
         if (strtod(buf, NULL) == x) break;
+    }
+    if (p > 17) p = 17;
+    /* %g writes 20 as 2e+01 with one digit: the same digits without an exponent where a person expects none (the
+     * exponent read from the text itself: no libm, the native FMU links none) */
+    if (isfinite(x) && a >= 1e-4 && a < 1e16 && (exp_at = strchr(buf, 'e')) != NULL) {
+        e = atoi(exp_at + 1);
+        snprintf(buf, len, "%.*f", p - 1 - e > 0 ? p - 1 - e : 0, x);
     }
     return buf;
 }
@@ -178,14 +222,17 @@ model_status core_check_range(fmu_core *c, const char *fn, int slot, const char 
 {
     const model_var *v = CORE_VAR(slot);
     char bx[32], blo[32], bhi[32], msg[CORE_MSG_LEN];
+    const char *unit = v->unit && v->unit[0] ? v->unit : NULL;
     if (!name) name = v->name;
     if (!isfinite(x))
-        return core_fail(c, MODEL_ERROR, "%s: %s = %g is not finite; accepted range [%s, %s]", fn, name, x,
-                         core_num(v->min, blo, sizeof blo), core_num(v->max, bhi, sizeof bhi));
+        return core_fail(c, MODEL_ERROR, "%s: %s = %g is not finite; accepted range [%s, %s]%s%s", fn, name, x,
+                         core_num(v->min, blo, sizeof blo), core_num(v->max, bhi, sizeof bhi), unit ? " " : "",
+                         unit ? unit : "");
     if (v->has_range && (x < v->min || x > v->max))
-        return core_fail(c, MODEL_ERROR, "%s: %s = %s out of range; accepted range [%s, %s]", fn, name,
-                         core_num(x, bx, sizeof bx), core_num(v->min, blo, sizeof blo),
-                         core_num(v->max, bhi, sizeof bhi));
+        return core_fail(c, MODEL_ERROR, "%s: %s = %s%s%s out of range; accepted range [%s, %s]%s%s", fn, name,
+                         core_num(x, bx, sizeof bx), unit ? " " : "", unit ? unit : "",
+                         core_num(v->min, blo, sizeof blo), core_num(v->max, bhi, sizeof bhi), unit ? " " : "",
+                         unit ? unit : "");
     /* a rule of the model between this variable and the fixed ones, once they are fixed */
     if (c->m && c->phase == PH_STEP && v->causality != VC_OUTPUT &&
         model_check_set(c->m, &c->v, slot, x, msg, sizeof msg) != MODEL_OK)
@@ -269,10 +316,15 @@ model_status core_exit_init(fmu_core *c, const char *fn)
     c->inputs_changed = 0;
     s = model_solve_now(c->m, &c->v, c->time, msg, sizeof msg);
     if (s != MODEL_OK) {
-        /* quasi-static: no balanced solution at the initial inputs; the first step reports it again */
+        /* quasi-static: no balanced solution at the initial inputs (or one deeper than the divergence depth). Not
+         * a refused call: the model is configured, the outputs are those the model wrote (the state at rest, or
+         * that solution), 'status' says 1 and 'message' why, and the first step tries again at its inputs (a sweep
+         * that starts outside goes on). OK, logged as a warning: a master that stops on any status above OK
+         * (fmusim) still records the initial row and reads the status there; the first step that cannot solve
+         * ends the run as any divergence does */
         c->i[MODEL_INFO.vr_status] = STATUS_DIVERGED;
-        core_warn(c, "%s: %s", fn, msg);
-        return MODEL_WARNING;
+        core_warn(c, "%s: %s (status = 1; the first step tries again at its inputs)", fn, msg);
+        snprintf(c->message, sizeof c->message, "%s: %s", fn, msg);
     }
     return MODEL_OK;
 }
@@ -341,6 +393,16 @@ model_status core_step(fmu_core *c, const char *fn, double t, double h, core_eve
         c->i[MODEL_INFO.vr_status] = STATUS_DIVERGED;
         c->stopped = 1;
         snprintf(c->stop_reason, sizeof c->stop_reason, "%s", msg);
+        if (c->d->end_run_with_ok) {
+            /* FMI 3.0: the step ends at the last successful time with its outputs, terminateSimulation says the
+             * run is over; a master records the row and stops (fmpy, fmusim), or rolls back */
+            c->time = c->last_good;
+            core_warn(c, "%s at t = %s s: %s (%s = true: the run ends at t = %s s; %s to an earlier state to go on)",
+                      fn, core_num(t, bt, sizeof bt), msg, c->d->terminated, core_num(c->last_good, bc, sizeof bc),
+                      c->d->set_state);
+            snprintf(c->message, sizeof c->message, "%s at t = %s s: %s", fn, bt, msg);
+            return MODEL_OK;
+        }
         return core_fail(c, s, "%s at t = %s s: %s (%s = true: the run ends at the last successful time %s s; %s to "
                          "an earlier state to go on)", fn, core_num(t, bt, sizeof bt), msg, c->d->terminated,
                          core_num(c->last_good, bc, sizeof bc), c->d->set_state);
@@ -493,12 +555,25 @@ model_status core_free_state(fmu_core *c, const char *fn, void **state)
 }
 
 /* serialised: magic, guid (64 bytes), phase, n_vars, n_model, stopped (8 bytes each), time, last_good, r[], i[],
- * message, stop_reason, model[] */
+ * message, stop_reason, model[], and the 64-bit FNV-1a checksum of every byte before it (any single changed byte
+ * changes it: each step of FNV-1a is a bijection of the running hash) */
 #define GUID_BYTES 64
 #define HEAD_BYTES (4 + GUID_BYTES + 4 * 8 + 2 * 8)
+#define SUM_BYTES 8
 static size_t serialized_size_of(size_t n_model)
 {
-    return HEAD_BYTES + CORE_N_VARS * 8 + CORE_N_VARS * 4 + 2 * CORE_MSG_LEN + n_model * 8;
+    return HEAD_BYTES + CORE_N_VARS * 8 + CORE_N_VARS * 4 + 2 * CORE_MSG_LEN + n_model * 8 + SUM_BYTES;
+}
+
+static unsigned long long fnv1a64(const unsigned char *bytes, size_t n)
+{
+    unsigned long long h = 0xcbf29ce484222325ull;
+    size_t k;
+    for (k = 0; k < n; ++k) {
+        h ^= bytes[k];
+        h *= 0x100000001b3ull;
+    }
+    return h;
 }
 
 model_status core_serialized_size(fmu_core *c, const char *fn, const void *state, size_t *size)
@@ -539,6 +614,8 @@ model_status core_serialize(fmu_core *c, const char *fn, const void *state, unsi
     PUT(p->message, CORE_MSG_LEN);
     PUT(p->stop_reason, CORE_MSG_LEN);
     if (p->n_model) PUT(p->model, p->n_model * 8);
+    u = fnv1a64(bytes, at);
+    PUT(&u, SUM_BYTES);
 #undef PUT
     return MODEL_OK;
 }
@@ -546,19 +623,24 @@ model_status core_serialize(fmu_core *c, const char *fn, const void *state, unsi
 model_status core_deserialize(fmu_core *c, const char *fn, const unsigned char *bytes, size_t size, void **state)
 {
     size_t at = 0, k;
-    unsigned long long phase, nv, nm, stopped;
+    unsigned long long phase, nv, nm, stopped, sum;
     unsigned magic;
     char guid[GUID_BYTES];
     snapshot_t *p;
     if (!bytes || !state) return core_fail(c, MODEL_ERROR, "%s: NULL pointer", fn);
-    if (size < HEAD_BYTES)
+    if (size < HEAD_BYTES + SUM_BYTES)
         return core_fail(c, MODEL_ERROR, "%s: %zu bytes: too short to be a state of this FMU", fn, size);
 #define GET(dst, nbytes) (memcpy((dst), bytes + at, (nbytes)), at += (nbytes))
     GET(&magic, 4);
     GET(guid, GUID_BYTES);
     guid[GUID_BYTES - 1] = '\0';
     if (magic != c->d->state_magic || strcmp(guid, MODEL_INFO.guid) != 0)
-        return core_fail(c, MODEL_ERROR, "%s: not a state of this FMU (wrong magic or GUID)", fn);
+        return core_fail(c, MODEL_ERROR, "%s: not a state of this FMU (wrong magic or GUID: another FMU's or build's, "
+                         "or changed there); nothing restored", fn);
+    memcpy(&sum, bytes + size - SUM_BYTES, SUM_BYTES);
+    if (size < HEAD_BYTES + SUM_BYTES || fnv1a64(bytes, size - SUM_BYTES) != sum)
+        return core_fail(c, MODEL_ERROR, "%s: corrupt state: its checksum does not match its %zu bytes (changed "
+                         "after it was serialized, or cut short); nothing restored", fn, size);
     GET(&phase, 8);
     GET(&nv, 8);
     GET(&nm, 8);

@@ -32,6 +32,10 @@ typedef struct {
     const char *exit_init;      /* fmi2ExitInitializationMode */
     const char *terminated;     /* fmi2Terminated: the flag that says the run ended */
     int read_before_init;       /* values may be read in the instantiated phase (FMI 3.0: the start values) */
+    /* a step after which the model cannot go on (a divergence) ends the run: FMI 2.0 says so with fmi2Discard and
+     * fmi2Terminated; FMI 3.0 with fmi3OK and terminateSimulation (its fmi3Discard means "nothing changed, the
+     * output arguments are undefined", which is not the case: the step reached a time and its outputs stand) */
+    int end_run_with_ok;
 } core_dialect;
 
 typedef struct fmu_core fmu_core;
@@ -89,8 +93,9 @@ model_status core_terminate(fmu_core *c, const char *fn);
 void core_reset(fmu_core *c);
 
 /* One communication step [t, t + h] with the divergence rule. to_event NULL: model_step; else the model's step
- * that ends at its first event inside the step (model_step_to_event: only the FMI 3.0 wrapper refers to it, so
- * the models without events need not define it), *early then 1 and the FMU's time the event's. */
+ * that ends at its first event inside the step (model_step_to_event), *early then 1 and the FMU's time the
+ * event's. A step that ends the run: MODEL_DISCARD, or with the dialect's end_run_with_ok MODEL_OK, the FMU's
+ * time then the last successful one; c->stopped says it in both. */
 typedef model_status (*core_event_step)(model_runtime *m, model_values *v, double t, double h, int *event, char *msg,
                                         size_t len);
 model_status core_step(fmu_core *c, const char *fn, double t, double h, core_event_step to_event, int *early);

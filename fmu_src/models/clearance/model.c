@@ -1,7 +1,7 @@
 /*
- * clearance_model.c: TipClearance in C behind the shared FMI wrapper (fmu_model.h): the closure of a fan's
- * tip clearance an engine's performance model would hand the contact model, from the spool speed alone
- * (fmu_src/engine/clearance_interface.py states the model):
+ * model.c: TipClearance in C behind the shared FMI wrapper (fmu_model.h): the closure of a fan's tip clearance
+ * an engine's performance model would hand the contact model, from the spool speed alone
+ * (fmu_src/models/clearance/variables.py states the model):
  *
  *     closure = closure0 + c_centrifugal Omega^2 + d_thermal,   tau dd_thermal/dt = c_thermal Omega^2 - d_thermal
  *
@@ -16,25 +16,21 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "fmu_model.h"
+#include "model.h"
 #include "rr_math.h"
-
-/* value references, the order of SPECS in clearance_interface.py (checked at build) */
-enum { VR_OMEGA, VR_CLOSURE0, VR_CC, VR_CT, VR_TAU, VR_CLOSURE, VR_CENTRIFUGAL, VR_THERMAL };
 
 #define STATE_TAG 52170501.0
 
 struct model_runtime {
     double closure0, cc, ct, tau;
     double t, d, w; /* time, thermal growth, the speed held over the last step */
-    double advanced;
 };
 
 static void outputs(const model_runtime *m, model_values *v)
 {
     double w = m->w, c = m->cc * w * w;
-    v->r[VR_CENTRIFUGAL] = c;
-    v->r[VR_THERMAL] = m->d;
+    v->r[VR_CLOSURE_CENTRIFUGAL] = c;
+    v->r[VR_CLOSURE_THERMAL] = m->d;
     v->r[VR_CLOSURE] = m->closure0 + c + m->d;
 }
 
@@ -46,9 +42,9 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
         return NULL;
     }
     m->closure0 = v->r[VR_CLOSURE0];
-    m->cc = v->r[VR_CC];
-    m->ct = v->r[VR_CT];
-    m->tau = v->r[VR_TAU];
+    m->cc = v->r[VR_C_CENTRIFUGAL];
+    m->ct = v->r[VR_C_THERMAL];
+    m->tau = v->r[VR_TAU_THERMAL];
     m->t = t0;
     m->w = v->r[VR_OMEGA];
     m->d = m->ct * m->w * m->w; /* warm at the initial speed: the engine ran there */
@@ -56,17 +52,6 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
 }
 
 void model_free(model_runtime *m) { free(m); }
-
-model_status model_check_set(const model_runtime *m, const model_values *v, int vr, double x, char *msg, size_t len)
-{
-    (void)m;
-    (void)v;
-    (void)vr;
-    (void)x;
-    (void)msg;
-    (void)len;
-    return MODEL_OK; /* the declared ranges are the only rules */
-}
 
 model_status model_step(model_runtime *m, model_values *v, double t, double h, char *msg, size_t len)
 {
@@ -76,7 +61,6 @@ model_status model_step(model_runtime *m, model_values *v, double t, double h, c
     m->w = w;
     m->d = target + (m->d - target) * rr_exp(-h / m->tau);
     m->t = t + h;
-    m->advanced = h;
     v->i[MODEL_INFO.vr_status] = STATUS_OK;
     outputs(m, v);
     return MODEL_OK;
@@ -90,8 +74,6 @@ model_status model_solve_now(model_runtime *m, model_values *v, double t, char *
     outputs(m, v);
     return MODEL_OK;
 }
-
-double model_time_advanced(const model_runtime *m) { return m->advanced; }
 
 /* layout: tag, t, d, w */
 size_t model_state_size(const model_runtime *m)

@@ -1,4 +1,4 @@
-"""The interface of TipClearance.fmu: the closure of the fan's tip clearance from the spool speed.
+"""TipClearance.fmu's variables: the closure of the fan's tip clearance from the spool speed.
 
     closure = closure0 + c_centrifugal Omega^2 + d_thermal,   tau_thermal dd_thermal/dt = c_thermal Omega^2 - d_thermal
 
@@ -7,10 +7,13 @@ with the centrifugal load at once, the casing's thermal growth lags the speed. T
 at the reference's top speed (224 rad/s): 0.3 mm centrifugal (titanium blades of 0.6 m on a 0.4 m hub:
 rho Omega^2 / E ~ 2e-3 1/m^2 over the blade gives about 0.28 mm, the disk adds a little), 0.2 mm thermal with
 a 2 s lag (a real casing takes tens of seconds; 2 s lets a 5 s scenario show the lag). The thermal growth
-starts warm at the initial speed (the engine was running there). The model is fmu_src/native/clearance_model.c.
+starts warm at the initial speed (the engine was running there). The model is model.c next to this file.
 """
 
 from __future__ import annotations
+
+from ...fmi.description import ModelInfo
+from ...fmi.variables import Var, default_nominal, numbered
 
 MODEL_IDENTIFIER = "TipClearance"
 DESCRIPTION = ("Closure of a fan's tip clearance from the spool speed: centrifugal growth c_centrifugal Omega^2 at "
@@ -25,24 +28,38 @@ DEFAULTS = {
     "tau_thermal": 2.0,  # s
 }
 
-UNITS = {"rad/s": {"rad": 1, "s": -1}, "m": {"m": 1}, "m.s2/rad2": {"m": 1, "rad": -2, "s": 2}, "s": {"s": 1}}
+# unit -> (SI base-unit exponents, display units)
+UNITS = {"rad/s": ({"rad": 1, "s": -1}, {}), "m": ({"m": 1}, {}), "m.s2/rad2": ({"m": 1, "rad": -2, "s": 2}, {}),
+         "s": ({"s": 1}, {})}
 
 DEFAULT_EXPERIMENT = {"startTime": 0.0, "stopTime": 5.0, "stepSize": 1e-3}
 
-# (name, type, causality, variability, unit, (min, max) or None, description), in value-reference order
-SPECS = [
-    ("Omega", "Real", "input", "continuous", "rad/s", (0.0, 1e4), "Spin speed of the LP spool, held over each step"),
-    ("closure0", "Real", "parameter", "fixed", "m", (-0.01, 0.01),
-     "Constant part of the closure (a cold build clearance offset; > 0 closes)"),
-    ("c_centrifugal", "Real", "parameter", "fixed", "m.s2/rad2", (0.0, 1e-6),
-     "Centrifugal growth of blades and disk per Omega^2 (at once)"),
-    ("c_thermal", "Real", "parameter", "fixed", "m.s2/rad2", (-1e-6, 1e-6),
-     "Steady thermal closure per Omega^2 (> 0: the rotor grows more than the casing)"),
-    ("tau_thermal", "Real", "parameter", "fixed", "s", (1e-3, 1e5), "Time constant of the thermal growth"),
-    ("closure", "Real", "output", "continuous", "m", None,
-     "Closure of the tip clearance, to the contact FMU's clearance_closure (> 0 closes)"),
-    ("closure_centrifugal", "Real", "output", "continuous", "m", None, "Centrifugal part c_centrifugal Omega^2"),
-    ("closure_thermal", "Real", "output", "continuous", "m", None, "Thermal part (lagging the speed)"),
-    ("status", "Integer", "output", "discrete", None, None, "0 = ok; 2 = bad parameter or input (call refused)"),
-    ("message", "String", "output", "discrete", None, None, "Cause of the last refused call"),
-]
+MODEL = ModelInfo(identifier=MODEL_IDENTIFIER, description=DESCRIPTION, units=UNITS,
+                  default_experiment=DEFAULT_EXPERIMENT)
+
+
+def variables(values: dict | None = None) -> list[Var]:
+    """TipClearance's variables in value-reference order, numbered; the start values of the parameters DEFAULTS
+    and of the input Omega 0, overridden by ``values``. New variables go at the end."""
+    x = {**DEFAULTS, **(values or {})}
+
+    def par(name: str, unit: str, rng: tuple[float, float], text: str, causality: str = "parameter",
+            variability: str = "fixed") -> Var:
+        start = float(x.get(name, 0.0))
+        return Var(name, "Real", causality, variability, text, unit=unit, start=start, min=rng[0], max=rng[1],
+                   nominal=default_nominal(start, rng))
+
+    return numbered([
+        par("Omega", "rad/s", (0.0, 1e4), "Spin speed of the LP spool, held over each step", "input", "continuous"),
+        par("closure0", "m", (-0.01, 0.01), "Constant part of the closure (a cold build clearance offset; > 0 closes)"),
+        par("c_centrifugal", "m.s2/rad2", (0.0, 1e-6), "Centrifugal growth of blades and disk per Omega^2 (at once)"),
+        par("c_thermal", "m.s2/rad2", (-1e-6, 1e-6),
+            "Steady thermal closure per Omega^2 (> 0: the rotor grows more than the casing)"),
+        par("tau_thermal", "s", (1e-3, 1e5), "Time constant of the thermal growth"),
+        Var("closure", "Real", "output", "continuous",
+            "Closure of the tip clearance, to the contact FMU's clearance_closure (> 0 closes)", unit="m"),
+        Var("closure_centrifugal", "Real", "output", "continuous", "Centrifugal part c_centrifugal Omega^2", unit="m"),
+        Var("closure_thermal", "Real", "output", "continuous", "Thermal part (lagging the speed)", unit="m"),
+        Var("status", "Integer", "output", "discrete", "0 = ok; 2 = bad parameter or input (call refused)"),
+        Var("message", "String", "output", "discrete", "Cause of the last refused call"),
+    ])

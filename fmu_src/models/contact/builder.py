@@ -1,33 +1,31 @@
-"""Build fmus/RotorCasingContact.fmu from the slave script and a copy of the library.
+"""Build RotorCasingContact.fmu in each of its flavours, from the one variable list (variables.py):
 
-    rotorub build-fmu [--params my.toml] [--out fmus]      (or: python fmu_src/build/pythonfmu_fmu.py [DEST])
+    rotorub build-fmu [--params my.toml] [--out fmus]                         the pythonfmu FMU
+    rotorub build-fmu --native [--fmi3] [--mode quasi_static] [--platforms ...]   the native C FMU, FMI 2.0 or 3.0
 
-The FMU carries, in its resources folder:
+* :func:`build_native_fmu`: model.c and the rotorub kernel behind the FMI layer's wrapper (fmu_src/fmi/), the
+  structure's matrices and the contact geometry's ingredients generated into model_data.c from the parameter
+  file; no Python on the host. FMI 3.0: the same model and numbers, the per-blade outputs as arrays of
+  n_blades, early return at a first contact.
+* :func:`build_fmu`: the pythonfmu FMU. It carries, in its resources folder, the slave (slave.py, staged as
+  ``rotorub_casing_contact_<h>.py``), a verbatim copy of the ``rotorub_model`` sources and data as
+  ``rotorub_model_<h>/`` with the compiled kernel in ``kernel/bin/<machine>-<os>/`` (x86_64-linux, and
+  x86_64-win when ziglang can cross-compile it: the platforms pythonfmu's binary exists for), ``model.npz`` (the
+  model assembled at build time: the host needs only numpy; a ``param_file`` given at run time is assembled
+  there, with scipy), ``reference.toml`` (the parameter file used when ``param_file`` is empty),
+  ``rotorub_fmu.json`` (the manifest: which package and parameter file to load, the variables, the constants)
+  and ``requirements.txt`` (what the host Python needs; ``pythonfmu deploy`` can install it). ``<h>`` is a hash of
+  all of it (fmu_src/fmi/pythonfmu.py says why); the library copy is imported under that name through relative
+  imports only, and the build refuses sources that import ``rotorub_model`` by its absolute name.
 
-* ``rotorub_casing_contact_<h>.py``: the pythonfmu slave (fmu_src/pythonfmu/rotorub_casing_contact.py);
-* ``rotorub_model_<h>/``: a verbatim copy of the ``rotorub_model`` sources and data, with
-  the compiled kernel in ``kernel/bin/<machine>-<os>/`` (x86_64-linux, and x86_64-win when
-  ziglang can cross-compile it: the platforms pythonfmu's binary exists for);
-* ``model.npz``: the model assembled from the parameter file at build time (the host needs
-  only numpy to run it; a ``param_file`` given at run time is assembled there, with scipy);
-* ``reference.toml``: the parameter file used when the ``param_file`` parameter is empty
-  (the embedded reference, or the file given with --params);
-* ``rotorub_fmu.json``: which package/parameter file to load and the number of blades;
-* ``requirements.txt``: what the host Python needs (``pythonfmu deploy`` can install it);
-* ``pythonfmu/``: pythonfmu's Python side (added by pythonfmu's builder).
-
-``<h>`` is a hash of everything above: every pythonfmu FMU in a process shares one
-interpreter and one ``sys.modules``, so two different builds (or another FMU built
-from this library) never load each other's modules, while two copies of the same
-build share them harmlessly. The library copy is imported under that name through
-relative imports only; the build refuses sources that import ``rotorub_model`` by
-its absolute name.
+The cross-check kit is written next to each FMU by ``rotorub build-fmu`` (crosscheck.py).
 """
 
 from __future__ import annotations
 
 import ast
 import hashlib
+import html
 import json
 import shutil
 import sys
@@ -35,66 +33,101 @@ import tempfile
 import zipfile
 from pathlib import Path
 
-HERE = Path(__file__).resolve().parent.parent  # fmu_src/
-SCRIPT = HERE / "pythonfmu" / "rotorub_casing_contact.py"
-INTERFACE = HERE / "interface.py"
-import rotorub_model  # noqa: E402 - the sources that travel inside the FMU, wherever they are installed
+import rotorub_model
 
-LIB = Path(rotorub_model.__file__).resolve().parent
-from .. import interface  # noqa: E402
+from ...fmi.compile import NativeBuildError
+from ...fmi.csource import c_array, c_double
+from ...fmi.description import model_description, xml_bytes
+from ...fmi.package import NativeBuild, build_native, documentation_html, guid_of
+from ...fmi.pythonfmu import BuildError, build_pythonfmu, pythonfmu_version
+from ...fmi.variables import as_plain, declared, scalars
+from . import variables as cv
 
-MODEL_IDENTIFIER = "RotorCasingContact"
+HERE = Path(__file__).resolve().parent  # fmu_src/models/contact/
+SLAVE = HERE / "slave.py"
+LIB = Path(rotorub_model.__file__).resolve().parent  # the sources that travel inside the pythonfmu FMU
+MODES = ("transient", "quasi_static")
 HOST_REQUIREMENTS = ["numpy>=1.26"]
 # scipy is needed only to assemble a model from a param_file other than the one built in
 OPTIONAL_REQUIREMENTS = ["scipy>=1.11"]
 # pythonfmu 0.7 ships its binary for these FMI platforms; the kernel is built for each (cross: ziglang)
 KERNEL_PLATFORMS = {"linux64": "x86_64-linux", "win64": "x86_64-win"}
 
-
-class BuildError(Exception):
-    pass
+__all__ = ["BuildError", "NativeBuildError", "build_fmu", "build_native_fmu", "model_data"]
 
 
-# pythonfmu 0.7.0's linux64 binary (libpythonfmu-export.so) releases its global
-# std::shared_ptr<PyState> twice at process exit: the C++ static destructor of `pyState`
-# (run by exit() through __cxa_atexit) frees the control block, then the ELF destructor
-# onLibraryUnload() -> finalizePythonInterpreter() runs `pyState = nullptr` on the destroyed
-# shared_ptr and decrements the use count inside the freed block (a 4-byte write into freed
-# memory; valgrind: "Invalid read of size 4 ... inside a block of size 128 free'd"). The .so is
-# never really unloaded (its STB_GNU_UNIQUE symbols make it NODELETE, so fmpy's dlclose is a no-op),
-# hence both always run at exit; when the freed chunk sits in a malloc bin the write corrupts its
-# link and glibc aborts later in _dl_fini ("corrupted double-linked list", 1 in 20 to 1 in 8
-# processes). The static destructor alone already releases the PyState (and finalises Python in a
-# native host), so the fix is one byte: onLibraryUnload's `jmp finalizePythonInterpreter` becomes
-# `ret`. benchmarks/bench_exit.py counts the abnormal exits before and after.
-_PYTHONFMU_SO_SHA256 = "4be156a552c16f30eb4395805c59855d8d4086056d0f165442565f6c5fbac0c9"  # 0.7.0 linux64
-_ON_UNLOAD_OFFSET = 0x16F30  # onLibraryUnload: endbr64; jmp finalizePythonInterpreter@plt
-_ON_UNLOAD_BYTES = bytes.fromhex("f30f1efae9")
+def _parameters(params_file: str | Path | None, mode: str):
+    from rotorub_model.structure.params import REFERENCE_FILE, load_parameters
+
+    if mode not in MODES:
+        raise NativeBuildError(f"mode: '{mode}' unknown; accepted: {', '.join(MODES)}")
+    path = Path(params_file) if params_file else REFERENCE_FILE
+    return path, load_parameters(path)  # validated now, not in the master
 
 
-def _patch_exit_double_release(fmu: Path) -> bool:
-    """Rewrite the FMU with its linux64 binary patched (see above); False (and a warning) if the binary
-    is not the known pythonfmu 0.7.0 one."""
-    member = f"binaries/linux64/{MODEL_IDENTIFIER}.so"
-    with zipfile.ZipFile(fmu) as z:
-        infos = z.infolist()
-        data = {i.filename: z.read(i.filename) for i in infos}
-    so = bytearray(data.get(member, b""))
-    if hashlib.sha256(so).hexdigest() != _PYTHONFMU_SO_SHA256:
-        print(f"build-fmu: warning: {member} is not pythonfmu 0.7.0's known binary: its exit-time double release "
-              "is not patched (processes may abort at exit; see fmu_src/build/pythonfmu_fmu.py)", file=sys.stderr)
-        return False
-    o = _ON_UNLOAD_OFFSET
-    if so[o:o + 5] != _ON_UNLOAD_BYTES:
-        raise BuildError(f"{member}: unexpected code at onLibraryUnload; not patched")
-    so[o + 4] = 0xC3  # ret
-    data[member] = bytes(so)
-    tmp = fmu.with_suffix(".fmu.tmp")
-    with zipfile.ZipFile(tmp, "w") as z:
-        for i in infos:
-            z.writestr(i, data[i.filename], compress_type=i.compress_type)
-    tmp.replace(fmu)
-    return True
+def model_data(model, variables) -> str:
+    """The contact model's part of model_data.c: where the kernel's outputs go, the structure's matrices and the
+    contact geometry's ingredients."""
+    from rotorub_model import kernel
+    from rotorub_model.contact.geometry import geometry_spec
+
+    vr = {v.name: v.vr for v in scalars(declared(variables, ("fmi2", "native")))}
+    nb = model.params.blades.count
+    index = [vr[f"blade[{j}].{b}"] for b in kernel.OUT_BLADE_NAMES for j in range(1, nb + 1)]
+    index += [vr[g] for g in kernel.OUT_GLOBAL_NAMES]
+    spec = geometry_spec(model, 2, 0.0, 0.0, True)
+    wear = [vr[f"wear.{k}"] for k in ("depth_max", "depth_mean", "volume", "plastic_work", "lobes")]
+    wear += [vr[f"wear.harmonic[{h}]"] for h in range(1, cv.WEAR_HARMONICS + 1)]
+    out = [
+        f"const int OUTPUT_INDEX[{len(index)}] = {{{', '.join(map(str, index))}}};",
+        f"const int WEAR_INDEX[{len(wear)}] = {{{', '.join(map(str, wear))}}};",
+        f"const double BLADE_THICKNESS = {c_double(model.params.blades.thickness)};", "",
+    ]
+    for key in ("M", "D", "K", "G1", "C1", "N2", "S2", "f_unit"):
+        out.append(c_array(key, getattr(model, key).ravel()))
+    out.append(c_array("PSI_TIP", spec["psi_tip"]))
+    out.append(c_array("MODES", spec["modes"], "int"))
+    out.append(c_array("T_DISK", spec["T"].ravel()))
+    out.append(c_array("R_DISK", spec["Rot"].ravel()))
+    out.append(
+        "const model_data MODEL_DATA = {\n"
+        f"    {model.n_dofs}, {nb},\n"
+        "    M, D, K, G1, C1, N2, S2, f_unit,\n"
+        f"    {c_double(spec['r_tip'])}, {c_double(spec['stagger'])}, {c_double(spec['z_cg'])},\n"
+        f"    {spec['blade_dof0']}, {spec['n_ritz']}, {spec['casing_dof0']}, {len(spec['modes'])},\n"
+        "    PSI_TIP, MODES, T_DISK, R_DISK\n};\n")
+    return "\n".join(out)
+
+
+def build_native_fmu(dest: str | Path = "fmus/native", params_file: str | Path | None = None,
+                     platforms: tuple[str, ...] | None = None, mode: str = "transient", fmi: str = "2.0") -> dict:
+    """Build ``dest/RotorCasingContact.fmu`` (native C, FMI ``fmi``: "2.0" or "3.0"); returns a summary dict.
+
+    ``platforms``: FMI platform folders by their FMI 2.0 names (default: every platform when ziglang is
+    installed, this machine's otherwise). ``mode``: the default of the ``mode`` parameter, and what the model
+    description declares: 'transient' (no output depends directly on an input) or 'quasi_static' (the outputs
+    depend on the inputs but the casing offset: direct feedthrough).
+    """
+    from rotorub_model import __version__ as lib_version
+    from rotorub_model import kernel
+    from rotorub_model.structure.model import build_model
+
+    params_path, params = _parameters(params_file, mode)
+    model = build_model(params)
+    defaults = cv.Defaults.from_parameters(params)
+    variables = cv.variables(defaults, mode)
+    three = fmi == "3.0"
+    facts = (f"{'FMI 3.0. ' if three else ''}Model built in from <code>{html.escape(params_path.name)}</code>; "
+             f"default mode: {mode}{f'; {defaults.n_blades} blades (n_blades)' if three else ''}. Manual: "
+             f"<code>documentation/FMU.md</code>{', section FMI 3.0' if three else ''}.")
+    # the kernel's sources by the names its package gives (it may be split into several files)
+    out = build_native(NativeBuild(model=cv.MODEL, variables=variables, model_dir=HERE, fmi=fmi,
+                                   feedthrough=mode == "quasi_static",
+                                   extra_sources=(*kernel.SOURCES, *kernel.HEADERS),
+                                   model_data=model_data(model, variables), facts=facts, salt=(mode,)),
+                       dest, platforms, f"rotorub {lib_version}", lib_version)
+    return {**out, "flavour": "native", "mode": mode, "parameters": str(params_path),
+            **({"instantiation_token": out["guid"]} if three else {})}
 
 
 def _library_files() -> list[Path]:
@@ -131,13 +164,6 @@ exception): a misuse the native FMU refuses with fmi2Error at the call (out-of-r
 a bad configuration or FMU state) is logged here and refused at the next fmi2DoStep, with fmi2Discard.</li>"""
 
 
-def _documentation(doc: Path, variables: list) -> None:
-    doc.mkdir(parents=True, exist_ok=True)
-    (doc / "index.html").write_text(interface.documentation_html(variables, "pythonfmu", PYTHONFMU_HOST,
-                                                                 PYTHONFMU_LIMITS))
-    shutil.copy2(HERE / "FMU.md", doc / "FMU.md")
-
-
 def _kernel_binaries(pkg: Path, platforms: tuple[str, ...] | None) -> list[str]:
     """Compile the kernel into the library copy for each FMI platform; returns the platforms built.
 
@@ -147,7 +173,7 @@ def _kernel_binaries(pkg: Path, platforms: tuple[str, ...] | None) -> list[str]:
     from rotorub_model import kernel
     from rotorub_model.kernel.compiler import CompilerError, host_platform_tag, zig_command
 
-    from .native_compile import progress
+    from ...fmi.compile import progress
 
     host = host_platform_tag()
     host_fmi = next((f for f, tag in KERNEL_PLATFORMS.items() if tag == host), None)
@@ -178,116 +204,72 @@ def _kernel_binaries(pkg: Path, platforms: tuple[str, ...] | None) -> list[str]:
 
 def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
               platforms: tuple[str, ...] | None = None, mode: str = "transient") -> dict:
-    """Build ``dest/RotorCasingContact.fmu``; returns a summary dict. Needs pythonfmu.
+    """Build ``dest/RotorCasingContact.fmu`` with pythonfmu; returns a summary dict.
 
-    ``platforms``: FMI platforms to compile the kernel for (default: this one, plus win64 when
-    ziglang is installed). ``mode``: the default of the ``mode`` parameter and what the model
-    description declares ('transient': no output depends directly on an input;
-    'quasi_static': the outputs follow Omega and imbalance, direct feedthrough).
+    ``platforms``: FMI platforms to compile the kernel for (default: this one, plus win64 when ziglang is
+    installed). ``mode``: the default of the ``mode`` parameter and what the model description declares
+    ('transient': no output depends directly on an input; 'quasi_static': direct feedthrough).
     """
-    try:
-        from pythonfmu import FmuBuilder
-        from pythonfmu import __version__ as pythonfmu_version
-    except ImportError:
-        raise BuildError("pythonfmu is not installed: pip install 'rotorub[fmu]'") from None
     from rotorub_model import __version__ as lib_version
     from rotorub_model.structure.model import build_model, save_model
-    from rotorub_model.structure.params import load_parameters, to_dict
+    from rotorub_model.structure.params import to_dict
 
-    params_path = Path(params_file) if params_file else LIB / "data" / "reference.toml"
-    params = load_parameters(params_path)  # validated now, not in the master
-    dest = Path(dest)
-    dest.mkdir(parents=True, exist_ok=True)
-
+    version = pythonfmu_version()
+    try:
+        params_path, params = _parameters(params_file, mode)
+    except NativeBuildError as exc:
+        raise BuildError(str(exc)) from None
     files = _library_files()
+    variables = cv.variables(cv.Defaults.from_parameters(params), mode)
+    own = scalars(declared(variables, ("fmi2", "pythonfmu")))
     h = hashlib.sha256()
-    if mode not in ("transient", "quasi_static"):
-        raise BuildError(f"mode: '{mode}' unknown; accepted: transient, quasi_static")
-    for p in [SCRIPT, INTERFACE, params_path, *files]:
+    for p in [SLAVE, params_path, *files]:
         h.update(str(p.relative_to(LIB) if p.is_relative_to(LIB) else p.name).encode())
         h.update(p.read_bytes())
-    h.update(pythonfmu_version.encode())
+    h.update(json.dumps([as_plain(v) for v in own]).encode())
+    h.update(version.encode())
     h.update(mode.encode())
     tag = h.hexdigest()[:10]
-    guid = interface.guid_of("pythonfmu", h.hexdigest())  # from everything the FMU carries, not the build time
+    guid = guid_of("pythonfmu", h.hexdigest())  # from everything the FMU carries, not the build time
     lib_name = f"rotorub_model_{tag}"
-    module_name = f"rotorub_casing_contact_{tag}"
-    interface_name = f"rotorub_fmu_interface_{tag}"
     manifest = {"library": lib_name, "library_version": lib_version, "parameters": "reference.toml",
-                "model": "model.npz", "interface": interface_name, "mode": mode,
-                "feedthrough": mode == "quasi_static", "n_blades": params.blades.count, "build": tag, "guid": guid,
-                "pythonfmu": pythonfmu_version, "host_requirements": HOST_REQUIREMENTS,
-                "optional_requirements": OPTIONAL_REQUIREMENTS}
-
-    added_modules = set()
-    before = set(sys.modules)
-    path_before = list(sys.path)
+                "model": "model.npz", "mode": mode, "feedthrough": mode == "quasi_static",
+                "n_blades": params.blades.count, "build": tag, "guid": guid, "pythonfmu": version,
+                "host_requirements": HOST_REQUIREMENTS, "optional_requirements": OPTIONAL_REQUIREMENTS,
+                "variables": [as_plain(v) for v in own], "constants": cv.SLAVE_CONSTANTS}
+    md = model_description(cv.MODEL, variables, fmi="2.0", token=guid, flavour="pythonfmu",
+                           generation_tool=f"rotorub {lib_version} (PythonFMU {version})", version=lib_version,
+                           feedthrough=mode == "quasi_static")
     with tempfile.TemporaryDirectory(prefix="rotorub_fmu_") as tmp:
-        stage = Path(tmp) / "stage"
-        stage.mkdir()
-        pkg = stage / lib_name
+        pkg = Path(tmp) / lib_name
         for p in files:
-            rel = p.relative_to(LIB)
-            out = pkg / rel
+            out = pkg / p.relative_to(LIB)
             out.parent.mkdir(parents=True, exist_ok=True)
             if p.suffix == ".py":
                 out.write_text(_check_relative_only(p, p.read_text()))
             else:
                 shutil.copy2(p, out)
-        shutil.copy2(params_path, stage / "reference.toml")
         model = build_model(params)
-        save_model(model, stage / "model.npz")
+        save_model(model, Path(tmp) / "model.npz")
         manifest["n_dofs"] = model.n_dofs
         manifest["parameter_values"] = to_dict(params)  # read without a TOML parser (Python 3.10 has none)
-        shutil.copy2(INTERFACE, stage / f"{interface_name}.py")
         manifest["kernel_platforms"] = _kernel_binaries(pkg, platforms)
-        (stage / "rotorub_fmu.json").write_text(json.dumps(manifest, indent=1))
-        (stage / "requirements.txt").write_text("\n".join(HOST_REQUIREMENTS) + "\n")
-        script = stage / f"{module_name}.py"
-        shutil.copy2(SCRIPT, script)
-        _documentation(Path(tmp) / "documentation",
-                       interface.variables(interface.Defaults.from_parameters(params), mode, flavour="pythonfmu"))
-        out_file = dest / f"{MODEL_IDENTIFIER}.fmu"
-        try:
-            FmuBuilder.build_FMU(
-                script, dest=out_file,
-                project_files=[pkg, stage / "reference.toml", stage / "model.npz", stage / "rotorub_fmu.json",
-                               stage / "requirements.txt", stage / f"{interface_name}.py"],
-                documentation_folder=Path(tmp) / "documentation",
-                canGetAndSetFMUstate=True, canSerializeFMUstate=True,
-            )
-        finally:
-            # the builder imports the script (and through it the library copy) into this process
-            # and leaves its folders on sys.path: undo that, the folders are about to disappear
-            added_modules = set(sys.modules) - before
-            for m in added_modules:
-                if m.split(".")[0] in (module_name, lib_name, interface_name, f"_doc_{module_name}"):
-                    sys.modules.pop(m, None)
-            sys.path[:] = path_before
-    exit_patch = _patch_exit_double_release(out_file)
+        out_file = Path(dest) / f"{cv.MODEL_IDENTIFIER}.fmu"
+        doc = documentation_html(cv.MODEL_IDENTIFIER, "FMI 2.0 co-simulation (pythonfmu)", cv.DESCRIPTION,
+                                 scalars(declared(variables, ("fmi2", "pythonfmu"))),
+                                 f"<h2>What the host needs</h2>\n{PYTHONFMU_HOST}\n<h2>Behaviour</h2>\n"
+                                 f"<ul><li>{html.escape(cv.STATUS_TEXT)}</li>\n{PYTHONFMU_LIMITS}</ul>\n"
+                                 "<p>The manual: <code>documentation/FMU.md</code>.</p>")
+        patched = build_pythonfmu(
+            out_file, identifier=cv.MODEL_IDENTIFIER, script=SLAVE, module_name=f"rotorub_casing_contact_{tag}",
+            description_xml=xml_bytes(md),
+            resources={lib_name: pkg, "reference.toml": params_path, "model.npz": Path(tmp) / "model.npz",
+                       "rotorub_fmu.json": json.dumps(manifest, indent=1),
+                       "requirements.txt": "\n".join(HOST_REQUIREMENTS) + "\n"},
+            documentation={"index.html": doc, "FMU.md": HERE / "FMU.md"})
     with zipfile.ZipFile(out_file) as z:
         names = z.namelist()
-        md = z.read("modelDescription.xml").decode()
     return {"fmu": str(out_file), "guid": guid, "size_bytes": out_file.stat().st_size, "files": len(names),
-            "variables": md.count("<ScalarVariable"), "blades": params.blades.count, "build": tag,
-            "parameters": str(params_path), "host_requirements": HOST_REQUIREMENTS,
-            "kernel_platforms": manifest["kernel_platforms"], "exit_double_release_patched": exit_patch}
-
-
-def main(argv: list[str] | None = None) -> int:
-    import argparse
-
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("dest", nargs="?", default="fmus")
-    ap.add_argument("--params", default=None)
-    ns = ap.parse_args(argv)
-    try:
-        print(json.dumps(build_fmu(ns.dest, ns.params), indent=1))
-    except BuildError as exc:
-        print(f"build-fmu: error: {exc}", file=sys.stderr)
-        return 2
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+            "variables": len(own), "blades": params.blades.count, "build": tag, "flavour": "pythonfmu",
+            "mode": mode, "parameters": str(params_path), "host_requirements": HOST_REQUIREMENTS,
+            "kernel_platforms": manifest["kernel_platforms"], "exit_double_release_patched": patched}

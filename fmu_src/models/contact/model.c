@@ -1,6 +1,6 @@
 /*
- * contact_model.c: RotorCasingContact in C, around the rotorub kernel. The same steps as the pythonfmu
- * slave (fmu_src/pythonfmu/rotorub_casing_contact.py) and the library, in the same order of operations,
+ * model.c: RotorCasingContact in C, around the rotorub kernel. The same steps as the pythonfmu slave
+ * (fmu_src/models/contact/slave.py) and the library, in the same order of operations,
  * so that the three give the same numbers:
  *
  *   transient     a step h is n = ceil(h / cap) kernel substeps, cap = min(dt_max, half the
@@ -14,7 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "contact_model.h"
+#include "model.h"
 #include "rr_math.h"
 
 #define RE_TOL 1e-6 /* a real part below this is a neutral mode's round-off (rotorub_model.analyses.stability) */
@@ -112,9 +112,9 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
     size_t nn = (size_t)n * n, off = 0;
     double *g;
     (void)t0; /* the contact model is autonomous: its state does not depend on the start time */
-    if (v->r[VR_G0] < -v->r[VR_MAX_PEN]) {
+    if (v->r[VR_G0] < -v->r[VR_MAX_PENETRATION]) {
         snprintf(msg, len, "g0 = %.6g mm: an interference deeper than max_penetration = %.6g mm; the run would "
-                 "diverge at t = 0 (accepted: g0 >= -max_penetration)", v->r[VR_G0] * 1e3, v->r[VR_MAX_PEN] * 1e3);
+                 "diverge at t = 0 (accepted: g0 >= -max_penetration)", v->r[VR_G0] * 1e3, v->r[VR_MAX_PENETRATION] * 1e3);
         return NULL;
     }
     m = (model_runtime *)zalloc(1, sizeof *m);
@@ -135,8 +135,8 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
     m->theta = (v->r[VR_THETA] * (180.0 / 3.14159265358979323846)) * (3.14159265358979323846 / 180.0);
     m->chord = v->r[VR_CHORD];
     m->dt_max = v->r[VR_DT_MAX];
-    m->max_pen = v->r[VR_MAX_PEN];
-    m->v_slip = v->r[VR_SLIP];
+    m->max_pen = v->r[VR_MAX_PENETRATION];
+    m->v_slip = v->r[VR_SLIP_VELOCITY];
 
     /* contact geometry (the kernel's, from the ingredients baked at build time) */
     m->geo_mem = (double *)zalloc((size_t)nb * P * (3 * 3 + 2 * 3 * n) + 2 * (size_t)nb * P * n +
@@ -251,9 +251,9 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
         int ns = v->i[VR_N_SECTORS];
         m->surf.n_sectors = ns;
         m->surf.wears = v->i[VR_LINER] == LINER_ABRADABLE;
-        m->surf.yield_force = v->r[VR_YIELD];
+        m->surf.yield_force = v->r[VR_YIELD_FORCE];
         m->surf.hardening = v->r[VR_HARDENING];
-        m->surf.thickness = v->r[VR_THICKNESS];
+        m->surf.thickness = v->r[VR_LINER_THICKNESS];
         m->cell_area = d->r_tip * (6.283185307179586476925286766559 / ns) * (m->chord * rr_cos(d->stagger));
         m->surf.work_weight = m->cell_area / (BLADE_THICKNESS * m->chord);
         m->surf_mem = (double *)zalloc((size_t)rr_surface_table_size(nb, np, ns) + (size_t)np * ns, sizeof(double));
@@ -286,7 +286,7 @@ static void set_clearance(model_runtime *m, double g0)
 static void finish_outputs(model_values *v, double max_real)
 {
     v->i[VR_N_CONTACT] = (int)v->r[VR_N_CONTACT];
-    v->r[VR_MAX_REAL] = max_real;
+    v->r[VR_MAX_REAL_EIG] = max_real;
 }
 
 /* substeps of a step h at spin speed w: the step limit is evaluated once per whole rad/s */
@@ -328,7 +328,7 @@ static void wear_outputs(model_runtime *m, model_values *v)
 {
     const double *out = m->wear;
     int k;
-    double closure = v->r[VR_CLOSURE];
+    double closure = v->r[VR_CLEARANCE_CLOSURE];
     if (!m->have_wear || m->surf.changed) {
         rr_surface_summary(&m->contact, &m->surf, m->cell_area, m->wear);
         m->surf.changed = 0;
@@ -348,9 +348,9 @@ static void wear_outputs(model_runtime *m, model_values *v)
  * nonzero. Once worn, the liner stays attached (its depths are nonzero) */
 static void attach_surface(model_runtime *m, const model_values *v)
 {
-    m->surf.closure = v->r[VR_CLOSURE];
-    m->surf.offset_x = v->r[VR_OFFSET_X];
-    m->surf.offset_y = v->r[VR_OFFSET_Y];
+    m->surf.closure = v->r[VR_CLEARANCE_CLOSURE];
+    m->surf.offset_x = v->r[VR_CASING_OFFSET_X];
+    m->surf.offset_y = v->r[VR_CASING_OFFSET_Y];
     m->contact.surface = m->surf.wears || m->surf.closure != 0.0 || m->surf.offset_x != 0.0 ||
                                  m->surf.offset_y != 0.0
                              ? &m->surf
@@ -432,12 +432,12 @@ static model_status static_solution(model_runtime *m, model_values *v, double w,
     double *J = m->K2, *A = m->Aeig, *C = m->Cm1;
     k_omega(d, w, m->Kw);
     for (i = 0; i < n; ++i) m->Fw[i] = me * w * w * d->f_unit[i];
-    m->contact.g0 = m->g0 - v->r[VR_CLOSURE]; /* the engine's closure: uniform, so a balanced solution still is */
+    m->contact.g0 = m->g0 - v->r[VR_CLEARANCE_CLOSURE]; /* the engine's closure: uniform, so a balanced solution still is */
     ok = rr_static_solve(&m->contact, w, m->Kw, m->Fw, m->have_qs ? m->qs : NULL, 1e-10, 60, q, &rel, &its, m->swork,
                          m->siwork);
     if (!ok) {
-        snprintf(msg, len, "no balanced static solution at Omega = %g rad/s, imbalance = %g kg.m, g0 = %g m "
-                 "(relative residual %.2e); the outputs hold the last solution", w, me, m->g0, rel);
+        snprintf(msg, len, "no balanced static solution at Omega = %g rad/s, imbalance = %g kg.m, g0 = %g mm "
+                 "(relative residual %.2e); the outputs hold the last solution", w, me, m->g0 * 1e3, rel);
         return MODEL_DISCARD;
     }
     /* x' = A x, x = (q, q'): A = [[0, I], [-M^-1 (K(W) - J), -M^-1 (D + W G1 - Jv)]] */
@@ -549,6 +549,14 @@ model_status model_solve_now(model_runtime *m, model_values *v, double t, char *
         finish_outputs(v, 0.0);
         wear_outputs(m, v);
         return MODEL_OK;
+    }
+    if (!m->have_qs) {
+        /* no solution found yet: the outputs of the rotor at rest against the casing (g0 less the engine's
+         * closure), which 'status' and 'message' qualify when no balanced solution is found at these inputs */
+        m->contact.g0 = m->g0 - v->r[VR_CLEARANCE_CLOSURE];
+        rr_outputs(&m->contact, m->qs, NULL, v->r[VR_OMEGA], m->phi_qs, OUTPUT_INDEX, v->r);
+        finish_outputs(v, 0.0);
+        wear_outputs(m, v);
     }
     return static_solution(m, v, v->r[VR_OMEGA], v->r[VR_IMBALANCE], m->phi_qs, msg, len);
 }

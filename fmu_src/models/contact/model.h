@@ -1,14 +1,21 @@
 /*
- * contact_model.h: what RotorCasingContact's model (contact_model.c) takes from the data
- * `rotorub build-fmu --native` generates into model_data.c from the parameter file and
- * fmu_src/interface.py: the structure's matrices, the contact geometry's ingredients and where the
- * kernel's outputs go.
+ * model.h: what RotorCasingContact's model (model.c) takes from the data the build generates into model_data.c
+ * from the parameter file (fmu_src/models/contact/builder.py): the structure's matrices, the contact geometry's
+ * ingredients and where the kernel's outputs go. Its value references are variables.h's (VR_<NAME>, generated
+ * from fmu_src/models/contact/variables.py), as are its enumerations' values (FORMULATION_3D, MODE_TRANSIENT,
+ * LINER_ABRADABLE, ...).
  */
 #ifndef ROTORUB_CONTACT_MODEL_H
 #define ROTORUB_CONTACT_MODEL_H
 
 #include "fmu_model.h"
 #include "rotorub_kernel.h"
+#include "variables.h"
+
+/* what this model writes beyond fmu_model.h's defaults */
+#define MODEL_HAS_CHECK_SET     /* g0 >= -max_penetration, also when g0 is tuned during the run */
+#define MODEL_HAS_STEP_TO_EVENT /* FMI 3.0 early return at a first contact */
+#define MODEL_HAS_TIME_ADVANCED /* a divergence reports the substep it reached */
 
 typedef struct {
     int n;                 /* generalised coordinates */
@@ -25,16 +32,6 @@ typedef struct {
 
 extern const model_data MODEL_DATA;
 
-/* value references the model reads and writes (fixed by fmu_src/interface.py; checked at build). Value
- * reference 4 is the pythonfmu flavour's param_file: the native FMU has no variable there. */
-enum {
-    VR_OMEGA, VR_IMBALANCE, VR_FORMULATION, VR_MODE, VR_PARAM_FILE_PYTHONFMU, VR_G0, VR_K_R, VR_MU, VR_THETA,
-    VR_CHORD, VR_DT_MAX, VR_MAX_PEN, VR_SLIP
-};
-extern const int VR_N_CONTACT, VR_MAX_REAL, VR_DT_INTERNAL, VR_N_SUBSTEPS;
-/* the liner and the engine's inputs on the casing (after every earlier variable) */
-extern const int VR_LINER, VR_YIELD, VR_HARDENING, VR_THICKNESS, VR_N_SECTORS, VR_CLOSURE, VR_OFFSET_X, VR_OFFSET_Y,
-    VR_CLEARANCE_EFFECTIVE;
 /* where rr_surface_summary's RR_WEAR_OUT values go (RR_WEAR_LOBES: the Integer array) */
 extern const int WEAR_INDEX[];
 extern const double BLADE_THICKNESS; /* [m]: a tip's footprint on the liner is this x the chord */
@@ -42,8 +39,5 @@ extern const double BLADE_THICKNESS; /* [m]: a tip's footprint on the liner is t
 extern const int OUTPUT_INDEX[];
 
 enum { STATUS_UNSTABLE = 3 }; /* quasi_static: the balanced solution is unstable */
-enum { FORMULATION_2D = 1, FORMULATION_3D = 2 };
-enum { MODE_TRANSIENT = 1, MODE_QUASI_STATIC = 2 };
-enum { LINER_RIGID = 1, LINER_ABRADABLE = 2 };
 
 #endif

@@ -1,7 +1,7 @@
 """RotorCasingContact: FMI 2.0 co-simulation slave around the rotorub library (pythonfmu).
 
 This file is the pythonfmu script of the pythonfmu flavour of ``RotorCasingContact.fmu``
-(built by ``rotorub build-fmu``, see fmu_src/build/pythonfmu_fmu.py and fmu_src/FMU.md). It contains no
+(built by ``rotorub build-fmu``, see builder.py and FMU.md next to it). It contains no
 physics: every number it outputs comes from the copy of ``rotorub_model`` carried in the FMU's
 resources folder (imported under a build-specific package name so it never collides with
 another copy of the library, or another pythonfmu FMU, in the same interpreter):
@@ -13,11 +13,13 @@ another copy of the library, or another pythonfmu FMU, in the same interpreter):
   step, and the largest real part of the eigenvalues by the kernel's eigen-solver, as the
   native FMU computes them.
 
-Its variables, ranges and model description are fmu_src/interface.py's, shared with the
-native FMU. pythonfmu turns a Python exception escaping a callback into fmi2Fatal and can
-return only fmi2OK or fmi2Discard otherwise, so no callback here lets an exception out: a
+Its variables, ranges and model description are variables.py's, shared with the native FMUs:
+the build writes them into the manifest this slave reads (it imports nothing of fmu_src) and the
+model description its ``to_xml`` hands to pythonfmu. pythonfmu turns a Python exception escaping a
+callback into fmi2Fatal and can return only fmi2OK or fmi2Discard otherwise, so no callback here lets
+an exception out: a
 misuse is logged (status fmi2Error, cause in ``message``) and refused at the first call that
-can refuse it, ``fmi2DoStep`` (fmi2Discard); fmu_src/FMU.md lists these limits.
+can refuse it, ``fmi2DoStep`` (fmi2Discard); FMU.md lists these limits.
 """
 
 from __future__ import annotations
@@ -26,14 +28,18 @@ import importlib
 import json
 import math
 import sys
+import zlib
 from pathlib import Path
+from types import SimpleNamespace
+from xml.etree.ElementTree import fromstring
 
 import numpy as np
 from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real, String
 from pythonfmu.enums import Fmi2Status
 
 MANIFEST = "rotorub_fmu.json"
-STATE_VERSION = 4
+DESCRIPTION_FILE = "model_description.xml"  # written by the build (fmu_src/fmi/pythonfmu.py), read by to_xml
+STATE_VERSION = 5
 RE_TOL = 1e-6  # a real part below this is a neutral mode's round-off (rotorub_model.analyses.stability)
 
 # submodules of the bundled library imported eagerly: a later lazy import must not
@@ -49,8 +55,8 @@ class _StepRefused(Exception):
     """A communication step this FMU refuses (fmi2Error), the instance left as it was."""
 
 
-def _load(resources: Path) -> tuple[dict, object, object]:
-    """(manifest, namespace of the bundled library's modules, the interface module)."""
+def _load(resources: Path) -> tuple[dict, object, SimpleNamespace]:
+    """(manifest, namespace of the bundled library's modules, the constants of the interface)."""
     manifest = json.loads((resources / MANIFEST).read_text())
     if str(resources) not in sys.path:
         sys.path.insert(0, str(resources))
@@ -66,7 +72,7 @@ def _load(resources: Path) -> tuple[dict, object, object]:
     # and a first instance whose configuration is refused (its folder then deleted by the master) would
     # otherwise leave the lazy load to find its sources gone
     lib.kernel.load()
-    return manifest, lib, importlib.import_module(manifest["interface"])
+    return manifest, lib, SimpleNamespace(**manifest["constants"])
 
 
 class RotorCasingContact(Fmi2Slave):
@@ -83,8 +89,7 @@ class RotorCasingContact(Fmi2Slave):
         self.copyright = "rotorub developers"
         self._ref = self._lib.params.from_dict(self._manifest["parameter_values"])
         self._feedthrough = bool(self._manifest.get("feedthrough", False))
-        self._vars = itf.variables(itf.Defaults.from_parameters(self._ref), self._manifest.get("mode", "transient"),
-                                   flavour="pythonfmu")
+        self._vars = [SimpleNamespace(**v) for v in self._manifest["variables"]]  # FMI 2.0 view, vr order
         self.guid = self._manifest["guid"]  # derived from the model at build time, not pythonfmu's uuid1()
         n = len(self._vars)
         self._slot = {v.name: i for i, v in enumerate(self._vars)}
@@ -263,10 +268,9 @@ class RotorCasingContact(Fmi2Slave):
 
     # ------------------------------------------------------------------ model description
     def to_xml(self, model_options=None):
-        """The model description of fmu_src/interface.py (the native FMU's, but for its GUID and tool)."""
-        return self._if.model_description(
-            self._vars, guid=str(self.guid), generation_tool=f"rotorub {self.version} (PythonFMU 0.7.0)",
-            version=self.version, needs_execution_tool=True, feedthrough=self._feedthrough)
+        """The model description the build wrote from variables.py (fmu_src/fmi/description.py: the native FMUs'
+        writer); pythonfmu calls this at build time only."""
+        return fromstring((self._resources / DESCRIPTION_FILE).read_bytes())
 
     # ------------------------------------------------------------------ FMI life cycle
     def setup_experiment(self, start_time=0.0, stop_time=None, tolerance=None):
@@ -541,8 +545,8 @@ class RotorCasingContact(Fmi2Slave):
         st = lib.static.solve_static(sim["model"], contact, omega, me=me, q0=sim["q_static"])
         if not st.converged:
             return False, (f"no balanced static solution at Omega = {omega:g} rad/s, imbalance = {me:g} kg.m, "
-                           f"g0 = {sim['g0']:g} m (relative residual {st.residual:.2e}); the outputs hold the last "
-                           "solution")
+                           f"g0 = {sim['g0'] * 1e3:g} mm (relative residual {st.residual:.2e}); the outputs hold the "
+                           "last solution")
         # the kernel's eigenvalues: the native FMU computes the same indicator with the same solver
         A = lib.linear.first_order(sim["model"], omega, *contact.jacobians(st.q, omega))
         max_real = float(lib.kernel.eigenvalues(A).real.max())
@@ -620,6 +624,8 @@ class RotorCasingContact(Fmi2Slave):
         """Everything _restore relies on, checked before anything changes."""
         if not isinstance(state, dict) or state.get("version") != STATE_VERSION:
             raise ValueError(state.get("error", "wrong version") if isinstance(state, dict) else "not a state")
+        if state.get("guid") != str(self.guid):
+            raise ValueError("saved by another FMU or build (its GUID is not this FMU's)")
         n = len(self._vars)
         rv, iv = np.asarray(state["rv"], dtype=float), np.asarray(state["iv"], dtype=np.int64)
         if rv.shape != (n,) or iv.shape != (n,) or len(state["sv"]) != n:
@@ -701,11 +707,17 @@ class RotorCasingContact(Fmi2Slave):
                 return x.item()
             return x
 
-        return json.dumps(plain(state)).encode("utf-8")  # floats round-trip exactly (shortest repr)
+        payload = json.dumps(plain(state)).encode("utf-8")  # floats round-trip exactly (shortest repr)
+        return payload + b"#%08x" % zlib.crc32(payload)  # a byte changed anywhere is found (CRC-32)
 
     @staticmethod
     def _fmu_state_from_bytes(data: bytes):
+        data = bytes(data)
+        payload, _, tail = data.rpartition(b"#")
+        if len(tail) != 8 or tail != b"%08x" % zlib.crc32(payload):
+            return {"version": None, "error": f"corrupt state: its checksum does not match its {len(data)} bytes "
+                                              "(changed after it was serialized, or cut short)"}
         try:
-            return json.loads(bytes(data).decode("utf-8"))
+            return json.loads(payload.decode("utf-8"))
         except Exception as exc:  # noqa: BLE001 - surfaced by _set_fmu_state
             return {"version": None, "error": f"serialized state is not valid ({exc})"}

@@ -1,24 +1,28 @@
-"""The interface of RotorCasingContact, one definition for both FMUs.
+"""RotorCasingContact's variables: the one list every build of the contact FMU is written from.
 
-The pythonfmu FMU registers these variables in this order (so its value references are the
-indices here) and writes its model description with :func:`model_description`; the native
-FMU's C variable table and model description are generated from the same list. A user swaps
-one file for the other without touching a connection.
+The native FMI 2.0 and FMI 3.0 FMUs and the pythonfmu FMU declare these variables with these value references,
+units, ranges and start values (fmu_src/fmi/variables.py numbers them, writes the FMI 2.0 and 3.0 views and
+the C tables), so a user swaps one file for the other without touching a connection. The per-blade outputs and
+the wear harmonics are arrays: one FMI 3.0 variable each (``blade.F_N`` of n_blades elements), one FMI 2.0 scalar
+per element (``blade[1].F_N``, ...).
 
-Ranges are declared for every input and parameter (min/max, inclusive as FMI says), with
-nominal values and display units (rpm, mm, deg); values outside are refused with fmi2Error by
-the native FMU (at the fmi2Set* call) and with a refused step by the pythonfmu one
-(``fmu_src/FMU.md``). Where a range is a modelling judgement, the description says why.
+Ranges are declared for every input and parameter (min/max, inclusive as FMI says), with nominal values and
+display units (rpm, mm, deg); values outside are refused with fmi2Error by the native FMU (at the fmi2Set* call)
+and with a refused step by the pythonfmu one (FMU.md next to this file). Where a range is a modelling
+judgement, the description says why.
+
+Adding a variable is one entry at the end of :func:`variables` (after every earlier one: their value references,
+and the connections of older systems, stay as they are); the builds, the C header ``variables.h`` (``VR_<NAME>``)
+and the model descriptions follow. FMU.md says how, for a parameter, an input and a per-blade output.
 """
 
 from __future__ import annotations
 
-import hashlib
 import math
-import uuid
-from dataclasses import dataclass, replace
-from datetime import datetime, timezone
-from xml.etree.ElementTree import Element, SubElement, tostring
+from dataclasses import dataclass
+
+from ...fmi.description import ModelInfo
+from ...fmi.variables import Var, numbered, tidy
 
 MODEL_IDENTIFIER = "RotorCasingContact"
 MODEL_NAME = "RotorCasingContact"
@@ -64,27 +68,6 @@ STATUS_TEXT = ("0 = ok; 1 = diverged (transient: a penetration beyond max_penetr
 
 
 @dataclass(frozen=True)
-class Var:
-    name: str
-    type: str  # Real, Integer, Enumeration, String
-    causality: str  # input, parameter, output
-    variability: str  # continuous, discrete, fixed, tunable
-    description: str
-    unit: str | None = None
-    display_unit: str | None = None
-    start: float | int | str | None = None
-    min: float | None = None
-    max: float | None = None
-    nominal: float | None = None
-    declared_type: str | None = None
-    vr: int = -1  # value reference (the same in both flavours; see variables())
-
-    @property
-    def settable(self) -> bool:
-        return self.causality in ("input", "parameter")
-
-
-@dataclass(frozen=True)
 class Defaults:
     """What the variable list takes from the parameter file the FMU is built with."""
 
@@ -110,9 +93,10 @@ class Defaults:
     @classmethod
     def from_parameters(cls, p) -> Defaults:
         b = p.blades
+        # the two computed bounds are range limits (a judgement): written as a person reads them (fmi.variables.tidy)
         return cls(n_blades=b.count, blade_length=b.length, omega_ref=p.normalisation.omega_ref,
-                   omega_max=p.normalisation.speed_max * p.normalisation.omega_ref, me=p.imbalance.me,
-                   me_max=b.mass * (b.hub_radius + 0.5 * b.length), g0=p.contact.g0, k_r=p.contact.k_r,
+                   omega_max=tidy(p.normalisation.speed_max * p.normalisation.omega_ref), me=p.imbalance.me,
+                   me_max=tidy(b.mass * (b.hub_radius + 0.5 * b.length)), g0=p.contact.g0, k_r=p.contact.k_r,
                    mu=p.contact.mu, theta=math.radians(p.contact.theta_deg), chord=p.contact.chord,
                    max_penetration=p.contact.max_penetration, slip_velocity=p.contact.slip_velocity,
                    liner=p.abradable.enabled, yield_force=p.abradable.yield_force, hardening=p.abradable.hardening,
@@ -143,17 +127,25 @@ WEAR_HARMONICS = 8  # the kernel's RR_WEAR_HARMONICS
 DEFAULT_SPEED = 3.3  # x omega_ref
 DEFAULT_EXPERIMENT = {"startTime": 0.0, "stopTime": 2.0, "stepSize": 1e-3}
 FLAVOURS = ("native", "pythonfmu")
+# the FMI 3.0 descriptions of the per-blade arrays (the FMI 2.0 elements are described blade by blade below)
+ARRAY_TEXT = {
+    "F_N": "Normal contact force on each blade",
+    "F_T": "Tangential (friction) force on each blade: mu*F_N against its sliding over the casing (positive: "
+           "against the spin)",
+    "gap_LE": "Gap at the leading edge of each blade (2D: the tip gap); negative = penetration",
+    "gap_TE": "Gap at the trailing edge of each blade (2D: the tip gap); negative = penetration",
+    "gap_tip": "Smallest gap of each blade (2D: the tip gap; 3D: the smaller of LE and TE, the gap being linear "
+               "along the chord)",
+    "contact_fraction": "Fraction of the chord of each blade in contact (2D: 0 or 1)",
+}
 
 
-def variables(d: Defaults, mode: str = "transient", flavour: str = "native") -> list[Var]:
-    """Every variable of a flavour, in value-reference order.
-
-    Both flavours number their variables the same way, so that one FMU replaces the other without
-    touching a connection: the pythonfmu flavour's ``param_file`` (value reference 4) has no
-    counterpart in the native one, whose numbering keeps the gap.
-    """
-    if flavour not in FLAVOURS:
-        raise ValueError(f"flavour: '{flavour}' unknown; accepted: {', '.join(FLAVOURS)}")
+def variables(d: Defaults, mode: str = "transient") -> list[Var]:
+    """Every variable of every build, numbered (fmu_src/fmi/variables.py): the pythonfmu flavour's ``param_file``
+    (value reference 4) has no counterpart in the native FMUs, whose numbering keeps the gap; ``time``, ``n_blades``
+    and ``penetration_margin`` are the FMI 3.0 FMU's."""
+    if mode not in ("transient", "quasi_static"):
+        raise ValueError(f"mode: '{mode}' unknown; accepted: transient, quasi_static")
     V: list[Var] = []
     add = V.append
     add(Var("Omega", "Real", "input", "continuous",
@@ -173,7 +165,7 @@ def variables(d: Defaults, mode: str = "transient", flavour: str = "native") -> 
             start=1 if mode == "transient" else 2, min=1, max=2, declared_type="Mode"))
     add(Var("param_file", "String", "parameter", "fixed",
             "Path of a rotorub TOML parameter file; empty: the model built into the FMU (assembled at initialisation, "
-            "which needs scipy on the host)", start=""))
+            "which needs scipy on the host)", start="", only="pythonfmu"))
     add(Var("g0", "Real", "parameter", "tunable",
             "Nominal blade-tip clearance (negative: initial interference); tunable between communication steps. "
             "Range: an interference as deep as max_penetration (deeper diverges at once: refused, also when "
@@ -196,7 +188,8 @@ def variables(d: Defaults, mode: str = "transient", flavour: str = "native") -> 
             "half the central-difference stability limit)) equal substeps", unit="s", display_unit="ms", start=1e-3,
             min=DT_MAX_RANGE[0], max=DT_MAX_RANGE[1], nominal=1e-4))
     add(Var("max_penetration", "Real", "parameter", "fixed",
-            "Divergence: a run stops (fmi2Discard, status 1) at the first substep where a blade penetrates the casing "
+            "Divergence: a run ends (status 1; FMI 2.0 fmi2Discard, FMI 3.0 terminateSimulation) at the first "
+            "substep where a blade penetrates the casing "
             "deeper than this (the depth of an abradable liner: deeper, the blade cuts the case structure and the "
             "penalty law means nothing)", unit="m", display_unit="mm", start=d.max_penetration,
             min=PENETRATION_RANGE[0], max=PENETRATION_RANGE[1], nominal=3e-3))
@@ -206,23 +199,19 @@ def variables(d: Defaults, mode: str = "transient", flavour: str = "native") -> 
             "the sliding near v = 0 (start from rest, run-down, windmilling). Range 0.1 mm/s to 10 m/s (far below "
             "the tip speeds; the smaller, the smaller the internal step the friction's damping allows)",
             unit="m/s", start=d.slip_velocity, min=SLIP_RANGE[0], max=SLIP_RANGE[1], nominal=0.1))
-    for j in range(1, d.n_blades + 1):
-        b = f"blade[{j}]"
-        add(Var(f"{b}.F_N", "Real", "output", "continuous", f"Normal contact force on blade {j}", unit="N"))
-        add(Var(f"{b}.F_T", "Real", "output", "continuous",
-                f"Tangential (friction) force on blade {j}: mu*F_N against its sliding over the casing (positive: "
-                "against the spin)", unit="N"))
-        add(Var(f"{b}.gap_LE", "Real", "output", "continuous",
-                f"Gap at the leading edge of blade {j} (2D: the tip gap); negative = penetration", unit="m",
-                display_unit="mm"))
-        add(Var(f"{b}.gap_TE", "Real", "output", "continuous",
-                f"Gap at the trailing edge of blade {j} (2D: the tip gap); negative = penetration", unit="m",
-                display_unit="mm"))
-        add(Var(f"{b}.gap_tip", "Real", "output", "continuous",
-                f"Smallest gap of blade {j} (2D: the tip gap; 3D: the smaller of LE and TE, the gap being linear "
-                "along the chord)", unit="m", display_unit="mm"))
-        add(Var(f"{b}.contact_fraction", "Real", "output", "continuous",
-                f"Fraction of the chord of blade {j} in contact (2D: 0 or 1)", unit="1"))
+    # per blade, blade 1's six outputs, then blade 2's, ... (their FMI 2.0 value references interleave)
+    for name, text2, unit, disp in (
+            ("F_N", "Normal contact force on blade {k}", "N", None),
+            ("F_T", "Tangential (friction) force on blade {k}: mu*F_N against its sliding over the casing (positive: "
+                    "against the spin)", "N", None),
+            ("gap_LE", "Gap at the leading edge of blade {k} (2D: the tip gap); negative = penetration", "m", "mm"),
+            ("gap_TE", "Gap at the trailing edge of blade {k} (2D: the tip gap); negative = penetration", "m", "mm"),
+            ("gap_tip", "Smallest gap of blade {k} (2D: the tip gap; 3D: the smaller of LE and TE, the gap being "
+                        "linear along the chord)", "m", "mm"),
+            ("contact_fraction", "Fraction of the chord of blade {k} in contact (2D: 0 or 1)", "1", None)):
+        add(Var(f"blade.{name}", "Real", "output", "continuous", ARRAY_TEXT[name] + " (element j: blade j)",
+                unit=unit, display_unit=disp, size=d.n_blades, element=f"blade[{{k}}].{name}",
+                element_description=text2, dimension="n_blades", interleave="blade"))
     add(Var("n_contact", "Integer", "output", "discrete", "Number of blades in contact (F_N > 0)"))
     for ax in "xyz":
         add(Var(f"casing_force.{ax}", "Real", "output", "continuous",
@@ -233,7 +222,7 @@ def variables(d: Defaults, mode: str = "transient", flavour: str = "native") -> 
         add(Var(f"disk_displacement.{ax}", "Real", "output", "continuous",
                 f"Fan-disk centre displacement, fixed frame, {ax} component", unit="m", display_unit="mm"))
     add(Var("gap_min", "Real", "output", "continuous", "Smallest gap over all blades and contact points", unit="m",
-            display_unit="mm"))
+            display_unit="mm", event_indicator=True))  # FMI 3.0: a first contact crosses 0 downwards
     add(Var("max_real_eig", "Real", "output", "continuous",
             "Largest real part of the eigenvalues linearised about the static solution (quasi_static mode; > 0: "
             "unstable); 0 in transient mode (not computed)", unit="1/s"))
@@ -271,7 +260,9 @@ def variables(d: Defaults, mode: str = "transient", flavour: str = "native") -> 
         add(Var(f"casing_offset.{ax}", "Real", "input", "continuous",
                 f"Rigid offset of the casing centre from a carcass or manoeuvre-load model, fixed frame, {ax} "
                 "component, held over each step (transient mode; the gap opens where the offset points)", unit="m",
-                display_unit="mm", start=0.0, min=OFFSET_RANGE[0], max=OFFSET_RANGE[1], nominal=1e-4))
+                display_unit="mm", start=0.0, min=OFFSET_RANGE[0], max=OFFSET_RANGE[1], nominal=1e-4,
+                # quasi_static: a balanced solution of the rotating frame cannot hold an offset fixed in the other
+                feedthrough=False))
     add(Var("wear.depth_max", "Real", "output", "discrete", "Deepest worn point of the liner", unit="m",
             display_unit="mm"))
     add(Var("wear.depth_mean", "Real", "output", "discrete",
@@ -282,173 +273,32 @@ def variables(d: Defaults, mode: str = "transient", flavour: str = "native") -> 
     add(Var("wear.lobes", "Integer", "output", "discrete",
             "Dominant lobe count of the worn profile: the harmonic 1-8 of largest amplitude (0: no wear, or worn "
             "evenly: no harmonic reaches 1 % of the mean depth)"))
-    for h in range(1, WEAR_HARMONICS + 1):
-        add(Var(f"wear.harmonic[{h}]", "Real", "output", "discrete",
-                f"Amplitude of the worn profile's harmonic {h} ({h} lobes)", unit="m", display_unit="mm"))
+    add(Var("wear.harmonic", "Real", "output", "discrete",
+            "Amplitudes of the worn profile's harmonics 1 to 8 (element h: h lobes): the worn profile as a fixed, "
+            "small set of outputs whatever n_sectors", unit="m", display_unit="mm", size=WEAR_HARMONICS,
+            element="wear.harmonic[{k}]",
+            element_description="Amplitude of the worn profile's harmonic {k} ({k} lobes)"))
     add(Var("clearance_effective", "Real", "output", "discrete",
             "Clearance the engine keeps: g0 - clearance_closure + the mean worn depth (what a performance model "
             "pays for)", unit="m", display_unit="mm"))
-    V = [replace(v, vr=k) for k, v in enumerate(V)]
-    return [v for v in V if flavour == "pythonfmu" or v.name != "param_file"]
+    # the FMI 3.0 FMU's own: after every FMI 2.0 variable, as they have always been
+    add(Var("time", "Real", "independent", "continuous", "Simulation time", unit="s", only="fmi3"))
+    add(Var("n_blades", "UInt64", "structuralParameter", "fixed",
+            "Number of blades: the size of the per-blade arrays, fixed by the parameter file the FMU was built with "
+            "(another blade count: rebuild with --params)", start=d.n_blades, min=d.n_blades, max=d.n_blades,
+            only="fmi3"))
+    add(Var("penetration_margin", "Real", "local", "continuous",
+            "gap_min + max_penetration: how far the deepest blade is from the divergence depth (the event indicator "
+            "of a divergence: it crosses 0 downwards when the run diverges)", unit="m", display_unit="mm",
+            sum_of=("gap_min", "max_penetration"), event_indicator=True, only="fmi3"))
+    # new variables go here, after every earlier one (their value references stay as they are)
+    return numbered(V)
 
 
-def _fmt(v: float | int) -> str:
-    return repr(float(v)) if isinstance(v, float) else str(v)
+MODEL = ModelInfo(identifier=MODEL_IDENTIFIER, name=MODEL_NAME, description=DESCRIPTION, units=UNITS,
+                  default_experiment=DEFAULT_EXPERIMENT, enumerations=ENUMERATIONS, might_return_early=True)
 
-
-def guid_of(*parts: bytes | str) -> str:
-    """A GUID derived from what makes an FMU what it is (its description, model data and sources), not from
-    the build time: the same model built twice has the same GUID, any change gives another one."""
-    h = hashlib.sha256()
-    for p in parts:
-        h.update(p.encode() if isinstance(p, str) else p)
-        h.update(b"\0")
-    return "{" + str(uuid.UUID(h.hexdigest()[:32])) + "}"
-
-
-def model_description(vars_: list[Var], *, guid: str, generation_tool: str, version: str,
-                      needs_execution_tool: bool, feedthrough: bool, source_files: list[str] | None = None,
-                      author: str = "rotorub developers", model_name: str = MODEL_NAME,
-                      model_identifier: str = MODEL_IDENTIFIER, description: str = DESCRIPTION,
-                      units: dict | None = None, enumerations: dict | None = None,
-                      default_experiment: dict | None = None, initial_from_parameters: bool = False) -> Element:
-    """The FMI 2.0 co-simulation model description of ``vars_`` (an ElementTree element); the contact
-    FMU's by default, any other model's (the LP spool) with its names, units and experiment.
-
-    ``feedthrough``: the outputs depend directly on the inputs (the quasi_static build: its
-    outputs are the algebraic solution at the current inputs); otherwise they depend on no
-    input (the transient build: outputs follow the state, no algebraic loop with the spool).
-
-    ``initial_from_parameters``: the initial outputs depend on the parameters alone, not on the inputs (the
-    spool's initial speed is its Omega0 whatever torque it is given): declared, so that a master that
-    propagates initial values (OMSimulator) sees no algebraic loop at initialisation. Otherwise an initial
-    output declares no dependencies: it may depend on everything, as FMI 2.0 reads that.
-    """
-    units = UNITS if units is None else units
-    enumerations = ENUMERATIONS if enumerations is None else enumerations
-    experiment = DEFAULT_EXPERIMENT if default_experiment is None else default_experiment
-    root = Element("fmiModelDescription", {
-        "fmiVersion": "2.0", "modelName": model_name, "guid": guid,
-        "description": description, "author": author, "version": version, "license": "MIT",
-        "copyright": author, "generationTool": generation_tool,
-        "generationDateAndTime": datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
-        "variableNamingConvention": "structured", "numberOfEventIndicators": "0"})
-    cs = SubElement(root, "CoSimulation", {
-        "modelIdentifier": model_identifier, "needsExecutionTool": str(needs_execution_tool).lower(),
-        "canHandleVariableCommunicationStepSize": "true", "canInterpolateInputs": "false",
-        "maxOutputDerivativeOrder": "0", "canRunAsynchronuously": "false",
-        "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions": "true",
-        "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true", "providesDirectionalDerivative": "false"})
-    if source_files:
-        sf = SubElement(cs, "SourceFiles")
-        for f in source_files:
-            SubElement(sf, "File", name=f)
-    used = {v.unit for v in vars_ if v.unit}
-    unit_defs = SubElement(root, "UnitDefinitions")
-    for name, (base, displays) in units.items():
-        if name not in used:
-            continue
-        u = SubElement(unit_defs, "Unit", name=name)
-        SubElement(u, "BaseUnit", {k: str(e) for k, e in base.items()})
-        for dname, factor in displays.items():
-            SubElement(u, "DisplayUnit", name=dname, factor=repr(factor))
-    types = SubElement(root, "TypeDefinitions") if enumerations else None
-    for tname, items in enumerations.items():
-        st = SubElement(types, "SimpleType", name=tname)
-        en = SubElement(st, "Enumeration")
-        for k, (item, desc) in enumerate(items, start=1):
-            SubElement(en, "Item", name=item, value=str(k), description=desc)
-    logs = SubElement(root, "LogCategories")
-    for cat, desc in (("logStatusWarning", "Log messages with fmi2Warning status."),
-                      ("logStatusDiscard", "Log messages with fmi2Discard status."),
-                      ("logStatusError", "Log messages with fmi2Error status."),
-                      ("logStatusFatal", "Log messages with fmi2Fatal status."),
-                      ("logAll", "Log all messages.")):
-        SubElement(logs, "Category", name=cat, description=desc)
-    SubElement(root, "DefaultExperiment", {k: _fmt(float(v)) for k, v in experiment.items()})
-    mv = SubElement(root, "ModelVariables")
-    for k, v in enumerate(vars_):
-        vr = v.vr if v.vr >= 0 else k
-        attrs = {"name": v.name, "valueReference": str(vr), "description": v.description, "causality": v.causality,
-                 "variability": v.variability}
-        if v.causality == "output":
-            attrs["initial"] = "calculated"
-        elif v.causality == "parameter":
-            attrs["initial"] = "exact"
-        sv = SubElement(mv, "ScalarVariable", attrs)
-        t = SubElement(sv, v.type)
-        if v.declared_type:
-            t.set("declaredType", v.declared_type)
-        if v.unit:
-            t.set("unit", v.unit)
-        if v.display_unit:
-            t.set("displayUnit", v.display_unit)
-        for key in ("min", "max", "nominal"):
-            val = getattr(v, key)
-            if val is not None:
-                t.set(key, _fmt(val))
-        if v.start is not None and v.causality != "output":
-            t.set("start", v.start if isinstance(v.start, str) else _fmt(v.start))
-    ms = SubElement(root, "ModelStructure")
-    outs = SubElement(ms, "Outputs")
-    # the quasi_static solution depends on the inputs but the casing's offset (a transient-mode input: a
-    # balanced solution of the rotating frame cannot hold a casing offset fixed in the other frame)
-    inputs = [str(i + 1) for i, v in enumerate(vars_)
-              if v.causality == "input" and not v.name.startswith("casing_offset")]
-    for i, v in enumerate(vars_):
-        if v.causality == "output":
-            attrs = {"index": str(i + 1)}
-            attrs["dependencies"] = " ".join(inputs) if feedthrough else ""
-            if feedthrough:
-                attrs["dependenciesKind"] = " ".join("dependent" for _ in inputs)
-            SubElement(outs, "Unknown", attrs)
-    init = SubElement(ms, "InitialUnknowns")
-    params = " ".join(str(i + 1) for i, v in enumerate(vars_) if v.causality == "parameter")
-    for i, v in enumerate(vars_):
-        if v.causality == "output":
-            attrs = {"index": str(i + 1)}
-            if initial_from_parameters:
-                attrs["dependencies"] = params
-            SubElement(init, "Unknown", attrs)
-    return root
-
-
-def xml_bytes(root: Element) -> bytes:
-    from xml.dom import minidom
-
-    return minidom.parseString(tostring(root, encoding="utf-8")).toprettyxml(indent="  ", encoding="UTF-8")
-
-
-def documentation_html(vars_: list[Var], flavour: str, host_needs: str, details: str) -> str:
-    """documentation/index.html of an FMU: what it is, what the host needs, the variables."""
-    import html
-
-    rows = "\n".join(
-        f"<tr><td><code>{html.escape(v.name)}</code></td><td>{v.causality}</td><td>{html.escape(v.unit or '')}"
-        f"{' (' + v.display_unit + ')' if v.display_unit else ''}</td>"
-        f"<td>{'' if v.min is None else f'[{v.min:g}, {v.max:g}]'}</td><td>{html.escape(v.description)}</td></tr>"
-        for v in vars_)
-    return f"""<!DOCTYPE html>
-<html><head><meta charset="utf-8"><title>{MODEL_IDENTIFIER} ({flavour})</title></head><body>
-<h1>{MODEL_IDENTIFIER} &mdash; blade-tip / casing contact, FMI 2.0 co-simulation ({flavour})</h1>
-<p>{html.escape(DESCRIPTION)}</p>
-<h2>What the host needs</h2>
-{host_needs}
-<h2>Behaviour</h2>
-<ul>
-<li>Inputs are held over each communication step (zero-order hold); variable step sizes are accepted. A step h
-is n = ceil(h / min(dt_max, half the central-difference stability limit)) equal substeps (transient mode).</li>
-<li>quasi_static mode: the balanced static solution at the held inputs and the largest real part of the
-eigenvalues of the linearised system; status 3 when it is unstable.</li>
-<li>fmi2Get/SetFMUstate and their serialisation restore the whole solver state (rollback); fmi2Reset returns to
-the instantiated state.</li>
-<li>{STATUS_TEXT}</li>
-{details}
-</ul>
-<p>The manual: <code>documentation/FMU.md</code>.</p>
-<h2>Variables</h2>
-<table border="1" cellspacing="0" cellpadding="3">
-<tr><th>name</th><th>causality</th><th>unit (display)</th><th>range</th><th>description</th></tr>
-{rows}
-</table></body></html>
-"""
+# what the pythonfmu slave reads from its manifest (it imports nothing of fmu_src)
+SLAVE_CONSTANTS = {"ENUMERATIONS": ENUMERATIONS, "STATUS_OK": STATUS_OK, "STATUS_DIVERGED": STATUS_DIVERGED,
+                   "STATUS_BAD_INPUT": STATUS_BAD_INPUT, "STATUS_UNSTABLE": STATUS_UNSTABLE,
+                   "MAX_SUBSTEPS": MAX_SUBSTEPS, "WEAR_HARMONICS": WEAR_HARMONICS}

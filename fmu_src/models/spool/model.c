@@ -1,8 +1,8 @@
 /*
- * spool_model.c: LPSpool in C behind the same FMI wrapper as the contact model (fmu_model.h): the speed
- * of a turbofan's low-pressure spool, J dOmega/dt = tau_drive(t) - c_w Omega^2 + friction_torque
- * (fmu_src/engine/spool_interface.py states the model; fmu_src/pythonfmu/spool_slave.py is the same model
- * written as a pythonfmu slave, the example of a slave in Python).
+ * model.c: LPSpool in C behind the same FMI wrapper as the contact model (fmu_model.h): the speed of a
+ * turbofan's low-pressure spool, J dOmega/dt = tau_drive(t) - c_w Omega^2 + friction_torque
+ * (fmu_src/models/spool/variables.py states the model; slave.py next to this file is the same model written as
+ * a pythonfmu slave, the example of a slave in Python).
  *
  * The state is the deviation e = Omega - Omega_s(t) from the speed schedule, advanced by classical RK4 in
  * n = ceil(h / dt_max) equal substeps with friction_torque held: with no external torque every RK4 stage
@@ -13,14 +13,8 @@
 #include <string.h>
 #include <stdlib.h>
 
-#include "fmu_model.h"
+#include "model.h"
 #include "rr_math.h"
-
-/* value references, the order of SPECS in spool_interface.py (checked at build) */
-enum {
-    VR_TAU, VR_J, VR_CW, VR_OMEGA0, VR_OMEGA1, VR_T_START, VR_T_RAMP, VR_DT_MAX, VR_OMEGA, VR_OMEGA_S, VR_DRIVE,
-    VR_WINDAGE
-};
 
 #define STATE_TAG 52170401.0
 #define PI 3.141592653589793
@@ -28,7 +22,6 @@ enum {
 struct model_runtime {
     double J, cw, w0, w1, t0, tr, dt_max;
     double t, e;
-    double advanced;
 };
 
 /* Omega_s(t) and its derivative */
@@ -55,9 +48,9 @@ static void outputs(const model_runtime *m, model_values *v)
     schedule(m, m->t, &ws, &wsd);
     w = ws + m->e;
     v->r[VR_OMEGA] = w;
-    v->r[VR_OMEGA_S] = ws;
-    v->r[VR_DRIVE] = m->J * wsd + m->cw * ws * ws;
-    v->r[VR_WINDAGE] = m->cw * w * w;
+    v->r[VR_OMEGA_SCHEDULE] = ws;
+    v->r[VR_DRIVE_TORQUE] = m->J * wsd + m->cw * ws * ws;
+    v->r[VR_WINDAGE_TORQUE] = m->cw * w * w;
 }
 
 model_runtime *model_configure(const model_values *v, double t0, char *msg, size_t len)
@@ -68,10 +61,10 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
         return NULL;
     }
     m->J = v->r[VR_J];
-    m->cw = v->r[VR_CW];
+    m->cw = v->r[VR_C_W];
     m->w0 = v->r[VR_OMEGA0];
     m->w1 = v->r[VR_OMEGA1];
-    m->t0 = v->r[VR_T_START];
+    m->t0 = v->r[VR_T_RAMP_START];
     m->tr = v->r[VR_T_RAMP];
     m->dt_max = v->r[VR_DT_MAX];
     m->t = t0;
@@ -80,17 +73,6 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
 }
 
 void model_free(model_runtime *m) { free(m); }
-
-model_status model_check_set(const model_runtime *m, const model_values *v, int vr, double x, char *msg, size_t len)
-{
-    (void)m;
-    (void)v;
-    (void)vr;
-    (void)x;
-    (void)msg;
-    (void)len;
-    return MODEL_OK; /* the declared ranges are the only rules */
-}
 
 static double rhs(const model_runtime *m, double s, double e, double tau)
 {
@@ -101,10 +83,9 @@ static double rhs(const model_runtime *m, double s, double e, double tau)
 
 model_status model_step(model_runtime *m, model_values *v, double t, double h, char *msg, size_t len)
 {
-    double tau = v->r[VR_TAU], e = m->e, ds, ws, wsd, w;
+    double tau = v->r[VR_FRICTION_TORQUE], e = m->e, ds, ws, wsd, w;
     double nd = rr_ceil(h / m->dt_max * (1.0 - 1e-12));
     int n, i;
-    m->advanced = 0.0;
     if (!(nd <= MODEL_MAX_SUBSTEPS)) {
         char bh[32], bd[32], bt[32];
         snprintf(msg, len, "communication step h = %s s needs %.0f substeps of at most dt_max = %s s; at most %d are "
@@ -128,13 +109,13 @@ model_status model_step(model_runtime *m, model_values *v, double t, double h, c
     w = ws + e;
     if (!isfinite(w) || w < 0.0) {
         v->i[MODEL_INFO.vr_status] = STATUS_DIVERGED; /* 1: the spool stopped */
-        snprintf(msg, len, "the spool would stop (Omega = %g rad/s at the end of the step, friction_torque = %g N.m); "
-                 "step refused, state unchanged", w, tau);
+        char bw[32], bt[32];
+        snprintf(msg, len, "the spool would stop (Omega = %s rad/s at the end of the step, friction_torque = %s N.m); "
+                 "step refused, state unchanged", core_num(w, bw, sizeof bw), core_num(tau, bt, sizeof bt));
         return MODEL_DISCARD;
     }
     m->e = e;
     m->t = t + h;
-    m->advanced = h;
     v->i[MODEL_INFO.vr_status] = STATUS_OK;
     outputs(m, v);
     return MODEL_OK;
@@ -148,8 +129,6 @@ model_status model_solve_now(model_runtime *m, model_values *v, double t, char *
     outputs(m, v);
     return MODEL_OK;
 }
-
-double model_time_advanced(const model_runtime *m) { return m->advanced; }
 
 /* layout: tag, t, e */
 size_t model_state_size(const model_runtime *m)

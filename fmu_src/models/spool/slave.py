@@ -1,11 +1,12 @@
 """LPSpool: FMI 2.0 co-simulation slave for the speed of the low-pressure spool, written with pythonfmu.
 
 This file is the pythonfmu script of the pythonfmu ``LPSpool.fmu`` (built by
-:func:`fmu_src.engine.spool.build_spool_fmu`, which stages it under a hashed module name,
+:func:`fmu_src.models.spool.builder.build_spool_fmu`, which stages it under a hashed module name,
 ``lpspool_<hash>``: every pythonfmu FMU in a process shares one ``sys.modules``). It is the example of
-a slave in Python; the engine system uses the native spool (fmu_src/native/spool_model.c), which has
-the same variables, value references, ranges and numbers to round-off. Both take their interface from
-fmu_src/engine/spool_interface.py (staged next to this script). numpy is not even needed.
+a slave in Python; the engine system uses the native spool (model.c next to this file), which has
+the same variables, value references, ranges and numbers to round-off. Both take their variables from
+variables.py: the build writes them, and the model description, into this slave's resources (it imports
+nothing of fmu_src). numpy is not even needed.
 
 Model: one rigid spool of polar inertia J,
 
@@ -40,27 +41,20 @@ fmi2SetFMUstate or fmi2Reset).
 
 from __future__ import annotations
 
-import importlib
 import json
 import math
-import sys
+import zlib
 from pathlib import Path
-from xml.etree.ElementTree import Element, SubElement
+from types import SimpleNamespace
+from xml.etree.ElementTree import fromstring
 
 from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real, String
 from pythonfmu.enums import Fmi2Status
 
-MANIFEST = "lpspool_defaults.json"  # parameter start values and the staged interface module's name
+MANIFEST = "lpspool.json"  # the variables (start values included), the constants, the GUID
+DESCRIPTION_FILE = "model_description.xml"  # written by the build (fmu_src/fmi/pythonfmu.py), read by to_xml
 STATUS_OK, STATUS_STOPPED, STATUS_ERROR = 0, 1, 2
-STATE_VERSION = 2
-
-
-def _interface(here: Path):
-    """The staged spool_interface module (and the manifest) from the FMU's resources."""
-    manifest = json.loads((here / MANIFEST).read_text())
-    if str(here) not in sys.path:
-        sys.path.insert(0, str(here))
-    return manifest, importlib.import_module(manifest["interface"])
+STATE_VERSION = 3
 
 
 class LPSpool(Fmi2Slave):
@@ -72,25 +66,23 @@ class LPSpool(Fmi2Slave):
         super().__init__(**kwargs)
         self.version = "1.0"
         self.copyright = "rotorub developers"
-        here = Path(self.resources) if self.resources else Path(__file__).parent
-        manifest, itf = _interface(here)
-        self._if = itf
-        self.guid = manifest["guid"]  # derived from the interface and the script at build time
+        self._here = here = Path(self.resources) if self.resources else Path(__file__).parent
+        manifest = json.loads((here / MANIFEST).read_text())
+        self._if = itf = SimpleNamespace(**manifest["constants"])
+        self.guid = manifest["guid"]  # derived from the variables and the script at build time
         self.description = itf.DESCRIPTION
-        defaults = dict(itf.DEFAULTS)
-        defaults.update(manifest.get("defaults", {}))
-        self._specs = itf.SPECS
-        n = len(self._specs)
+        self._vars = [SimpleNamespace(**v) for v in manifest["variables"]]  # value-reference order
+        n = len(self._vars)
         self._values: list = [0.0] * n
-        self._slot = {s[0]: i for i, s in enumerate(self._specs)}
-        for name, value in defaults.items():
-            if name in self._slot:
-                self._values[self._slot[name]] = float(value)
+        self._slot = {v.name: i for i, v in enumerate(self._vars)}
+        for v in self._vars:
+            if v.start is not None:
+                self._values[v.vr] = float(v.start)
         self._values[self._slot["status"]] = STATUS_OK
         self._values[self._slot["message"]] = ""
         self._stopped = None  # (time, reason) once a step was refused because the spool stopped
-        for i, spec in enumerate(self._specs):
-            self._register(i, spec)
+        for i, v in enumerate(self._vars):
+            self._register(i, v)
         self._phase = "instantiated"  # -> initialization -> step -> terminated
         self._t = 0.0  # current communication point
         self._e = 0.0  # state: Omega - Omega_schedule
@@ -101,9 +93,9 @@ class LPSpool(Fmi2Slave):
         self._update_outputs()
 
     # ------------------------------------------------------------------ variables
-    def _register(self, i: int, spec) -> None:
-        name, kind, causality, variability, _unit, _range, desc = spec
-        cls, conv = {"Real": (Real, float), "Integer": (Integer, int), "String": (String, str)}[kind]
+    def _register(self, i: int, v) -> None:
+        name, causality, variability, desc = v.name, v.causality, v.variability, v.description
+        cls, conv = {"Real": (Real, float), "Integer": (Integer, int), "String": (String, str)}[v.type]
         initial = Fmi2Initial.calculated if causality == "output" else None
 
         def getter(i=i, conv=conv):
@@ -112,14 +104,16 @@ class LPSpool(Fmi2Slave):
         def setter(v, i=i, conv=conv):
             self._set_value(i, conv(v))
 
-        v = cls(name, causality=Fmi2Causality[causality], variability=Fmi2Variability[variability],
-                description=desc, initial=initial, getter=getter, setter=setter)
-        self.register_variable(v, nested=False)
-        assert v.value_reference == i
+        var = cls(name, causality=Fmi2Causality[causality], variability=Fmi2Variability[variability],
+                  description=desc, initial=initial, getter=getter, setter=setter)
+        self.register_variable(var, nested=False)
+        assert var.value_reference == i
 
     def _set_value(self, i: int, value) -> None:
         """Store a value set by the master; never raises (checks happen in initialization and do_step)."""
-        name, kind, causality, variability, _unit, rng = self._specs[i][:6]
+        v = self._vars[i]
+        name, causality, variability = v.name, v.causality, v.variability
+        rng = None if v.min is None else (v.min, v.max)
         if causality == "output":
             self.log(f"{name}: is an output and cannot be set; value ignored", Fmi2Status.error)
             return
@@ -144,38 +138,9 @@ class LPSpool(Fmi2Slave):
 
     # ------------------------------------------------------------------ model description
     def to_xml(self, model_options=None):
-        """pythonfmu's description plus units, InitialUnknowns, no direct feedthrough, a default experiment."""
-        root = super().to_xml(model_options or {})
-        root.set("guid", str(self.guid))
-        units = Element("UnitDefinitions")
-        for name, base in self._if.UNITS.items():
-            SubElement(SubElement(units, "Unit", name=name), "BaseUnit", {k: str(v) for k, v in base.items()})
-        children = list(root)
-        cs_pos = next(i for i, el in enumerate(children) if el.tag == "CoSimulation")
-        root.insert(cs_pos + 1, units)
-        if root.find("DefaultExperiment") is None:
-            de = Element("DefaultExperiment", {k: repr(float(v)) for k, v in self._if.DEFAULT_EXPERIMENT.items()})
-            root.insert(list(root).index(root.find("ModelVariables")), de)
-        for sv, spec in zip(root.find("ModelVariables"), self._specs):
-            real = sv.find("Real")
-            if real is None:
-                continue
-            if real.get("start") is not None:  # pythonfmu writes %.16g: not round-trip
-                real.set("start", repr(float(self._values[self._slot[spec[0]]])))
-            if spec[4] is not None:
-                real.set("unit", spec[4])
-            if spec[5] is not None:
-                real.set("min", repr(float(spec[5][0])))
-                real.set("max", repr(float(spec[5][1])))
-        ms = root.find("ModelStructure")
-        outs = ms.find("Outputs")
-        init = SubElement(ms, "InitialUnknowns")
-        # the initial speed is Omega0's, whatever torque the spool is given: no loop at initialisation either
-        params = " ".join(str(i + 1) for i, spec in enumerate(self._specs) if spec[2] == "parameter")
-        for u in outs:
-            u.set("dependencies", "")  # the outputs at t depend on the state only, not on the input at t
-            SubElement(init, "Unknown", index=u.get("index"), dependencies=params)
-        return root
+        """The model description the build wrote from variables.py (fmu_src/fmi/description.py: the native spool's
+        writer); pythonfmu calls this at build time only."""
+        return fromstring((self._here / DESCRIPTION_FILE).read_bytes())
 
     # ------------------------------------------------------------------ FMI life cycle
     def setup_experiment(self, start_time=0.0, stop_time=None, tolerance=None):
@@ -224,15 +189,15 @@ class LPSpool(Fmi2Slave):
     # ------------------------------------------------------------------ physics
     def _check_parameters(self) -> dict:
         """The parameters, checked against their declared ranges (raises ValueError naming the first bad one)."""
-        v = {}
-        for name, _kind, causality, _var, unit, rng, _desc in self._specs:
-            if causality != "parameter":
+        out = {}
+        for v in self._vars:
+            if v.causality != "parameter":
                 continue
-            x = float(self._v(name))
-            if not (math.isfinite(x) and rng[0] <= x <= rng[1]):
-                raise ValueError(f"{name} = {x!r} {unit} out of range; accepted range [{rng[0]!r}, {rng[1]!r}]")
-            v[name] = x
-        return v
+            x = float(self._v(v.name))
+            if not (math.isfinite(x) and v.min <= x <= v.max):
+                raise ValueError(f"{v.name} = {x!r} {v.unit} out of range; accepted range [{v.min!r}, {v.max!r}]")
+            out[v.name] = x
+        return out
 
     def _schedule(self, t: float) -> tuple[float, float]:
         """(Omega_s(t), dOmega_s/dt) of the speed schedule."""
@@ -326,36 +291,51 @@ class LPSpool(Fmi2Slave):
 
     # ------------------------------------------------------------------ FMU state (rollback)
     def _get_fmu_state(self):
-        return {"version": STATE_VERSION, "values": list(self._values), "phase": self._phase, "t": self._t,
-                "e": self._e, "cfg": None if self._cfg is None else dict(self._cfg), "fatal": self._fatal_msg,
-                "stopped": None if self._stopped is None else list(self._stopped)}
+        return {"version": STATE_VERSION, "guid": str(self.guid), "values": list(self._values), "phase": self._phase,
+                "t": self._t, "e": self._e, "cfg": None if self._cfg is None else dict(self._cfg),
+                "fatal": self._fatal_msg, "stopped": None if self._stopped is None else list(self._stopped)}
 
     def _set_fmu_state(self, state):
-        try:
+        try:  # everything checked before anything changes: a refused state leaves the instance as it was
             if not isinstance(state, dict) or state.get("version") != STATE_VERSION:
                 why = state.get("error") if isinstance(state, dict) else None
                 raise ValueError(why or "not an LPSpool state of this version")
+            if state.get("guid") != str(self.guid):
+                raise ValueError("saved by another FMU or build (its GUID is not this FMU's)")
             values = list(state["values"])
             if len(values) != len(self._values):
                 raise ValueError("the state was saved by an FMU with another variable set")
-            self._values[:] = values
-            self._phase, self._t, self._e = state["phase"], float(state["t"]), float(state["e"])
-            self._cfg = None if state["cfg"] is None else dict(state["cfg"])
-            self._fatal_msg = state["fatal"]
-            self._stopped = None if state.get("stopped") is None else (float(state["stopped"][0]),
-                                                                       str(state["stopped"][1]))
-            self._pending = None
-        except Exception as exc:  # noqa: BLE001
-            self._configuration_error(f"fmi2SetFMUstate: the state could not be restored ({type(exc).__name__}: "
-                                      f"{exc})")
+            phase, t, e = state["phase"], float(state["t"]), float(state["e"])
+            if phase not in ("instantiated", "initialization", "step", "terminated") or not (
+                    math.isfinite(t) and math.isfinite(e)):
+                raise ValueError("phase, time or state invalid")
+            cfg = None if state["cfg"] is None else dict(state["cfg"])
+            stopped = None if state.get("stopped") is None else (float(state["stopped"][0]), str(state["stopped"][1]))
+        except Exception as exc:  # noqa: BLE001 - pythonfmu cannot return fmi2Error: logged, the next step refused
+            msg = f"fmi2SetFMUstate: not a state of this FMU ({type(exc).__name__}: {exc}); nothing restored"
+            self._pending = msg
+            self._set_out("message", msg)
+            self.log(f"LPSpool: {msg}", Fmi2Status.error)
+            return
+        self._values[:] = values
+        self._phase, self._t, self._e, self._cfg = phase, t, e, cfg
+        self._fatal_msg = state["fatal"]
+        self._stopped = stopped
+        self._pending = None
 
     @staticmethod
     def _fmu_state_to_bytes(state) -> bytes:
-        return json.dumps(state).encode("utf-8")  # floats round-trip exactly (shortest repr)
+        payload = json.dumps(state).encode("utf-8")  # floats round-trip exactly (shortest repr)
+        return payload + b"#%08x" % zlib.crc32(payload)  # a byte changed anywhere is found (CRC-32)
 
     @staticmethod
     def _fmu_state_from_bytes(data: bytes):
+        data = bytes(data)
+        payload, _, tail = data.rpartition(b"#")
+        if len(tail) != 8 or tail != b"%08x" % zlib.crc32(payload):
+            return {"version": None, "error": f"corrupt state: its checksum does not match its {len(data)} bytes "
+                                              "(changed after it was serialized, or cut short)"}
         try:
-            return json.loads(bytes(data).decode("utf-8"))
+            return json.loads(payload.decode("utf-8"))
         except Exception as exc:  # noqa: BLE001 - surfaced by _set_fmu_state
             return {"version": None, "error": f"serialized state is not valid ({exc})"}

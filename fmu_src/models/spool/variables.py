@@ -1,11 +1,8 @@
-"""The interface of LPSpool, one definition for both spool FMUs (native C and pythonfmu).
+"""LPSpool's variables, one list for both spool FMUs (native C and pythonfmu): the native build turns it into
+the C tables and variables.h, the pythonfmu build into the slave's manifest (the slave imports nothing of
+fmu_src); both write their model description from it (fmu_src/fmi/description.py).
 
-Pure data and no imports from the package: the pythonfmu build stages this file next to the slave
-script (under a hashed module name, as the contact FMU's interface), and the native build turns it
-into the C variable table (fmu_src/build/native_fmu.py). Value references are the positions in SPECS.
-
-Model (fmu_src/native/spool_model.c, fmu_src/pythonfmu/spool_slave.py): one rigid spool of polar
-inertia J,
+Model (model.c, slave.py next to this file): one rigid spool of polar inertia J,
 
     J dOmega/dt = tau_drive(t) - c_w Omega^2 + friction_torque,
 
@@ -20,6 +17,9 @@ finite is refused (fmi2Discard, status 1: the spool stops; the run ends).
 """
 
 from __future__ import annotations
+
+from ...fmi.description import ModelInfo
+from ...fmi.variables import Var, default_nominal, numbered
 
 MODEL_IDENTIFIER = "LPSpool"
 DESCRIPTION = (
@@ -42,46 +42,65 @@ DEFAULTS = {
     "dt_max": 1.0e-3,  # s
 }
 
-# FMI 2.0 unit definitions: name -> SI base-unit exponents
+# unit -> (SI base-unit exponents, display units)
 UNITS = {
-    "rad/s": {"rad": 1, "s": -1},
-    "N.m": {"kg": 1, "m": 2, "s": -2},
-    "kg.m2": {"kg": 1, "m": 2},
-    "N.m.s2/rad2": {"kg": 1, "m": 2, "rad": -2},
-    "s": {"s": 1},
+    "rad/s": ({"rad": 1, "s": -1}, {}),
+    "N.m": ({"kg": 1, "m": 2, "s": -2}, {}),
+    "kg.m2": ({"kg": 1, "m": 2}, {}),
+    "N.m.s2/rad2": ({"kg": 1, "m": 2, "rad": -2}, {}),
+    "s": ({"s": 1}, {}),
 }
 
 DEFAULT_EXPERIMENT = {"startTime": 0.0, "stopTime": 5.0, "stepSize": 1e-3}
 
-# (name, type, causality, variability, unit, (min, max) or None, description), in value-reference order.
-# The ranges are the ones an engine spool can have (a few grams to a hundred tonnes metre squared, ...):
-# declared so that a tool checks them, and refused outside.
-SPECS = [
-    ("friction_torque", "Real", "input", "continuous", "N.m", (-1e8, 1e8),
-     "External axial torque on the spool, held over each communication step: the friction torque of the "
-     "blade-tip contact (negative brakes the spin)"),
-    ("J", "Real", "parameter", "fixed", "kg.m2", (1e-3, 1e5),
-     "Polar moment of inertia of the whole LP spool (fan hub and blades, shaft, LP turbine)"),
-    ("c_w", "Real", "parameter", "fixed", "N.m.s2/rad2", (0.0, 1e3),
-     "Windage coefficient: windage torque c_w Omega^2 opposing the spin"),
-    ("Omega0", "Real", "parameter", "fixed", "rad/s", (0.0, 1e4),
-     "Initial spin speed, held until t_ramp_start (start of the speed schedule)"),
-    ("Omega1", "Real", "parameter", "fixed", "rad/s", (0.0, 1e4),
-     "Final spin speed of the schedule, reached at t_ramp_start + t_ramp"),
-    ("t_ramp_start", "Real", "parameter", "fixed", "s", (-1e6, 1e6), "Time the run-up (or run-down) starts"),
-    ("t_ramp", "Real", "parameter", "fixed", "s", (1e-6, 1e6),
-     "Duration of the speed change Omega0 -> Omega1 (half-cosine: zero acceleration at both ends)"),
-    ("dt_max", "Real", "parameter", "fixed", "s", (1e-7, 1.0),
-     "Largest internal RK4 step: each communication step h is split into ceil(h / dt_max) equal substeps"),
-    ("Omega", "Real", "output", "continuous", "rad/s", None, "Spin speed of the LP spool"),
-    ("Omega_schedule", "Real", "output", "continuous", "rad/s", None,
-     "Speed the drive schedule was designed for: the speed of the spool without external torque"),
-    ("drive_torque", "Real", "output", "continuous", "N.m", None,
-     "Drive torque of the schedule, J dOmega_schedule/dt + c_w Omega_schedule^2 (open loop)"),
-    ("windage_torque", "Real", "output", "continuous", "N.m", None, "Windage torque c_w Omega^2 (brakes the spin)"),
-    ("status", "Integer", "output", "discrete", None, None,
-     "0 = ok, 1 = the spool stopped (Omega would fall below 0 or stop being finite; step refused, the run ends), "
-     "2 = bad parameter or input (message in the log; call refused)"),
-    ("message", "String", "output", "discrete", None, None,
-     "Cause of the last refused call (the text also sent to the FMI logger); empty after a step that succeeded"),
-]
+MODEL = ModelInfo(identifier=MODEL_IDENTIFIER, description=DESCRIPTION, units=UNITS,
+                  default_experiment=DEFAULT_EXPERIMENT, initial_from_parameters=True)
+
+
+def variables(values: dict | None = None) -> list[Var]:
+    """The spool's variables in value-reference order, numbered; the start values DEFAULTS overridden by
+    ``values``. The ranges are the ones an engine spool can have (a few grams to a hundred tonnes metre squared,
+    ...): declared so that a tool checks them, and refused outside. New variables go at the end."""
+    x = {**DEFAULTS, **(values or {})}
+
+    def par(name: str, unit: str, rng: tuple[float, float], text: str, causality: str = "parameter",
+            variability: str = "fixed") -> Var:
+        start = float(x.get(name, 0.0))
+        return Var(name, "Real", causality, variability, text, unit=unit, start=start, min=rng[0], max=rng[1],
+                   nominal=default_nominal(start, rng))
+
+    def out(name: str, unit: str, text: str) -> Var:
+        return Var(name, "Real", "output", "continuous", text, unit=unit)
+
+    return numbered([
+        par("friction_torque", "N.m", (-1e8, 1e8),
+            "External axial torque on the spool, held over each communication step: the friction torque of the "
+            "blade-tip contact (negative brakes the spin)", "input", "continuous"),
+        par("J", "kg.m2", (1e-3, 1e5),
+            "Polar moment of inertia of the whole LP spool (fan hub and blades, shaft, LP turbine)"),
+        par("c_w", "N.m.s2/rad2", (0.0, 1e3), "Windage coefficient: windage torque c_w Omega^2 opposing the spin"),
+        par("Omega0", "rad/s", (0.0, 1e4), "Initial spin speed, held until t_ramp_start (start of the speed schedule)"),
+        par("Omega1", "rad/s", (0.0, 1e4), "Final spin speed of the schedule, reached at t_ramp_start + t_ramp"),
+        par("t_ramp_start", "s", (-1e6, 1e6), "Time the run-up (or run-down) starts"),
+        par("t_ramp", "s", (1e-6, 1e6),
+            "Duration of the speed change Omega0 -> Omega1 (half-cosine: zero acceleration at both ends)"),
+        par("dt_max", "s", (1e-7, 1.0),
+            "Largest internal RK4 step: each communication step h is split into ceil(h / dt_max) equal substeps"),
+        out("Omega", "rad/s", "Spin speed of the LP spool"),
+        out("Omega_schedule", "rad/s",
+            "Speed the drive schedule was designed for: the speed of the spool without external torque"),
+        out("drive_torque", "N.m",
+            "Drive torque of the schedule, J dOmega_schedule/dt + c_w Omega_schedule^2 (open loop)"),
+        out("windage_torque", "N.m", "Windage torque c_w Omega^2 (brakes the spin)"),
+        Var("status", "Integer", "output", "discrete",
+            "0 = ok, 1 = the spool stopped (Omega would fall below 0 or stop being finite; step refused, the run "
+            "ends), 2 = bad parameter or input (message in the log; call refused)"),
+        Var("message", "String", "output", "discrete",
+            "Cause of the last refused call (the text also sent to the FMI logger); empty after a step that "
+            "succeeded"),
+    ])
+
+
+# what the pythonfmu slave reads from its manifest (it imports nothing of fmu_src)
+SLAVE_CONSTANTS = {"DESCRIPTION": DESCRIPTION, "DEFAULTS": DEFAULTS, "MAX_SUBSTEPS": MAX_SUBSTEPS,
+                   "STATUS_OK": STATUS_OK, "STATUS_STOPPED": STATUS_STOPPED, "STATUS_ERROR": STATUS_ERROR}
