@@ -400,7 +400,7 @@ def test_simulate_leaves_no_dangling_logger_in_fmpy(native_fmu, tmp_path):
     """fmpy.simulate_fmu(logger=f) leaves fmpy's process-wide log proxy pointing at f's ctypes thunk, freed
     when the run ends; the next FMU logging through fmpy's default callbacks (the native FMU logs every
     refusal) then jumped into freed memory: a segfault of the whole suite, found by a helper with gdb and
-    valgrind. fmu_src.harness.fmi_run.simulate drives an instance with callbacks of its own instead. In a
+    valgrind. fmu_src.masters.fmi2.simulate drives an instance with callbacks of its own instead. In a
     subprocess: the failure is a crash."""
     import subprocess
     import sys

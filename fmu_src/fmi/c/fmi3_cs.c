@@ -6,8 +6,8 @@
  *     references given, or the call is refused with nothing stored;
  *   - Enumerations are read and written with fmi3GetInt64 / fmi3SetInt64, as the standard says;
  *   - early return: instantiated with earlyReturnAllowed, fmi3DoStep ends at the model's first event inside the
- *     step (model_step_to_event; the contact model: the first internal substep that brings a blade into contact
- *     from a state without contact), with earlyReturn = true and lastSuccessfulTime that substep's end; without
+ *     step (model_step_to_event: the first internal substep at which one of its event indicators crosses 0),
+ *     with earlyReturn = true and lastSuccessfulTime that substep's end; without
  *     it, every step is the FMI 2.0 FMU's, bit for bit. No event mode (hasEventMode = false): the models' events
  *     change no discrete state, there is nothing for an event mode to update;
  *   - the divergence rule in FMI 3.0's terms: the step that diverges (or finds no balanced solution) returns fmi3OK

@@ -1,7 +1,6 @@
 /*
  * fmu_model.h: the contract between the FMI co-simulation wrappers and a model behind them (fmu_src/models/<model>/
- * model.c: RotorCasingContact, LPSpool, TipClearance), as the Modelica Reference-FMUs keep one small model source
- * behind their FMI 1/2/3 wrappers. fmi2_cs.c (FMI 2.0) and fmi3_cs.c (FMI 3.0) are thin layers over fmu_core.c,
+ * model.c), as the Modelica Reference-FMUs keep one small model source behind their FMI 1/2/3 wrappers. fmi2_cs.c (FMI 2.0) and fmi3_cs.c (FMI 3.0) are thin layers over fmu_core.c,
  * which holds what both share: the values, the state machine, the checks, the divergence rule and the FMU-state
  * snapshots. None of these files knows a model.
  *

@@ -1,7 +1,7 @@
 /*
  * engine_host.c - a fixed-step co-simulation master for a system of FMI 2.0 co-simulation FMUs, in C: no
  * Python in the process. It is what runs the engine system's SSP package (LP spool + blade-tip contact)
- * "as written" in a native process: fmu_src/engine/ssp.py reads the package (components, parameter sets,
+ * "as written" in a native process: fmu_src/systems/ssp.py reads the package (components, parameter sets,
  * connections, step) and calls this host with the value references; the simulation itself is C only.
  *
  *   cc -std=c99 -O2 -o engine_host engine_host.c -ldl
@@ -12,7 +12,7 @@
  *               [-c FROM:VR=TO:VR]...               a connection: Real output of FROM to Real input of TO
  *               [-o NAME:VR]... [-i NAME:VR]...     Real / Integer columns of the CSV
  *
- * Exchange (Jacobi, as fmu_src/engine/coupling.py's fmpy master and libcosim's fixed-step algorithm): at each
+ * Exchange (Jacobi, as fmu_src/systems/coupling.py's fmpy master and libcosim's fixed-step algorithm): at each
  * communication point t_k every input is set from the outputs of every FMU at t_k, then every FMU steps over
  * [t_k, t_k + h] with its inputs held. Output (stdout): a header "time,NAME:rVR...,NAME:iVR..." and one row
  * at t_0 (after the first exchange) and after every step, reals in %.17g.

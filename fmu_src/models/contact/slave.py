@@ -208,7 +208,7 @@ class RotorCasingContact(Fmi2Slave):
     def _readable(self, fn: str) -> None:
         """FMI 2.0 co-simulation: values are read from fmi2EnterInitializationMode on. The native FMU returns
         fmi2Error; a getter of pythonfmu 0.7 that raises makes fmi2Fatal, so this one logs the error and
-        returns the start values (fmu_src/FMU.md, 'What pythonfmu cannot honour')."""
+        returns the start values (fmu_src/models/contact/FMU.md, 'What pythonfmu cannot honour')."""
         if self._phase == "instantiated":
             self._log_error(f"{fn}: the instance is instantiated: values are read from fmi2EnterInitializationMode "
                             "on (the start values are in modelDescription.xml)")

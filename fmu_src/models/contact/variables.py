@@ -123,7 +123,7 @@ WEAR_HARMONICS = 8  # the kernel's RR_WEAR_HARMONICS
 
 
 # the default experiment (both flavours): the paper's section-6 speed and the reference imbalance held from t = 0,
-# long enough for the blades to reach the casing and settle into rubbing (tests/test_fmi_behaviour.py runs it)
+# long enough for the blades to reach the casing and settle into rubbing (tests/fmu/test_fmi2.py runs it)
 DEFAULT_SPEED = 3.3  # x omega_ref
 DEFAULT_EXPERIMENT = {"startTime": 0.0, "stopTime": 2.0, "stepSize": 1e-3}
 FLAVOURS = ("native", "pythonfmu")
