@@ -55,9 +55,8 @@ class Slave3:
     def call(self, fn: str, *args) -> int:
         from fmpy.fmi1 import FMICallException
 
-        try:
-            getattr(self.f, fn)(self.f.component, *args)
-            return OK
+        try:  # fmpy raises above Warning and returns the status otherwise (a Warning is not OK: fmusim stops on it)
+            return int(getattr(self.f, fn)(self.f.component, *args))
         except FMICallException as exc:
             return exc.status
 

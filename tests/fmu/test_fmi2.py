@@ -72,9 +72,8 @@ class Inst:
         self.t = 0.0
 
     def call(self, fn: str, *args) -> int:
-        try:
-            getattr(self.f, fn)(self.f.component, *args)
-            return OK
+        try:  # fmpy raises above Warning and returns the status otherwise
+            return int(getattr(self.f, fn)(self.f.component, *args))
         except FMICallException as exc:
             return exc.status
 
@@ -505,6 +504,55 @@ def test_a_diverging_run_ends_in_standard_masters(unzipped, flavour, master):
         finally:
             i.free()
     assert time.perf_counter() - t0 < 30.0
+
+
+QS_DIVERGES_AT_START = {"mode": 2, "g0": 0.0, "max_penetration": 1e-5, "Omega": 176.2, "imbalance": 0.022}
+
+
+@pytest.mark.parametrize("master", ["fmpy.simulate_fmu", "fmusim loop"])
+def test_a_quasi_static_divergence_at_initialisation_gives_every_master_a_row(unzipped, flavour, master):
+    """Issue 24.7: no balanced solution at the initial inputs (here one deeper than max_penetration) made the native
+    fmi2ExitInitializationMode return fmi2Warning, and fmusim, which stops at any status above OK (its CALL macro),
+    wrote an empty result. It is fmi2OK now with status = 1 and the reason in 'message' (and in the log, a warning):
+    every master has the initial row and reads why there; the first step then ends the run (fmi2Discard,
+    fmi2Terminated)."""
+    if master == "fmpy.simulate_fmu":
+        r = fmpy.simulate_fmu(unzipped, start_values=QS_DIVERGES_AT_START, stop_time=1.0, output_interval=1e-3,
+                              output=["status", "gap_min"])
+        assert len(r) == 2 and (r["status"] == 1).all() and r["time"][0] == 0.0
+        return
+    i = Inst(unzipped)
+    try:
+        rows = []
+        if i.init(**QS_DIVERGES_AT_START) == OK:  # fmusim: CALL(FMI2ExitInitializationMode(S)), any status > OK ends
+            rows.append((0.0, i.integer("status"), i.message()))
+            s = i.call("fmi2DoStep", 0.0, 1e-3, fmi2Boolean(1))
+            assert s == DISCARD and _terminated(i)
+            rows.append((_last_successful_time(i), i.integer("status"), i.message()))
+        assert [r[:2] for r in rows] == [(0.0, 1), (0.0, 1)]
+        assert "penetrates the casing" in rows[0][2] and "max_penetration" in rows[0][2]
+        if flavour == "native":  # logged as a warning whether or not logging is on (pythonfmu: DOCUMENTED_LIMIT)
+            assert "penetrates the casing" in i.logged(level=WARNING)
+    finally:
+        i.free()
+
+
+def test_numbers_in_messages_read_as_a_person_reads_them(inst, flavour):
+    """Issue 24.7: messages wrote 20 as 2e+01 and the declared maximum imbalance as 4.093319999999999. Now the
+    shortest decimal that reads back as the same double, without an exponent between 1e-4 and 1e16, with the unit
+    (native; the pythonfmu slave writes Python's repr: 20.0)."""
+    assert inst.call("fmi2SetupExperiment", 0, 0.0, 0.0, 0, 0.0) == OK
+    assert inst.call("fmi2EnterInitializationMode") == OK
+    inst.set_real(imbalance=20.0)
+    said = inst.said()
+    assert "e+01" not in said and "4.093319999999999" not in said, said
+    if flavour == "native":
+        assert "imbalance = 20 kg.m out of range; accepted range [0, 4.09332] kg.m" in said, said
+    else:
+        assert "imbalance = 20.0 out of range; accepted range [0.0, 4.09332]" in said, said
+    inst.set_real(k_r=2e10)
+    assert ("k_r = 20000000000 N/m out of range; accepted range [1000, 10000000000] N/m" if flavour == "native"
+            else "k_r = 20000000000.0 out of range") in inst.said()
 
 
 def test_set_fmu_state_right_after_instantiation(inst, unzipped):

@@ -280,6 +280,83 @@ def test_divergence_with_early_return_allowed_returns_early_at_the_time_reached(
         assert term and early and t0 < last < point and i.t == last and i.get("status") == 1
 
 
+def fmusim3_loop(unzipped, start: dict, stop: float = 5.0, h: float = 1e-3, mode: int | None = None) -> dict:
+    """The co-simulation loop of fmusim 0.0.39's FMI3CSSimulation.c, as written: every call through its CALL macro
+    (any status above OK ends the run, keeping the rows recorded so far), a row after initialisation and after each
+    step (at lastSuccessfulTime on an early return, else at the communication point), the run ended on
+    terminateSimulation after that step's row. Returns the rows' times and statuses and the status it ended with."""
+    rows, status = [], OK
+    with Slave3(None, unzipped=str(unzipped), name="fmusim") as s:
+        def call(st: int) -> bool:
+            nonlocal status
+            status = st
+            return st > OK
+
+        values = {**start, **({"mode": mode} if mode else {})}
+        if not (call(s.call("fmi3EnterInitializationMode", False, 0.0, 0.0, True, stop)) or call(s.set(**values))
+                or call(s.call("fmi3ExitInitializationMode"))):
+            rows.append((0.0, int(s.get("status"))))
+            t = 0.0
+            while t < stop - 1e-12:
+                st, term, early, last = s.step(h, t)
+                if call(st):
+                    break
+                t = last if early else t + h
+                rows.append((t, int(s.get("status"))))
+                if term:
+                    break
+    return {"rows": rows, "status": status}
+
+
+@pytest.mark.parametrize("master", ["fmpy.simulate_fmu", "fmpy simulate", "fmusim loop"])
+def test_a_diverging_run_keeps_its_rows_in_every_master(fmu3, unzipped3, master, tmp_path):
+    """Issue 24.7: simulate_fmu(fmu3, start_values={"g0": -2.9e-3}) raised FMICallException (fmi3DoStep failed
+    with status 2 (discard)) and `fmpy simulate` exited 1 with no file: fmpy's FMI 3.0 loop raises on a Discard.
+    The diverging step now ends the run as FMI 3.0 says (fmi3OK, terminateSimulation): every master keeps the rows
+    so far and the diverged step's, whose status is 1, as the FMI 2.0 FMU gives them."""
+    start = {"g0": -2.9e-3}  # an interference: the blades go past max_penetration within a few steps
+    if master == "fmpy.simulate_fmu":
+        r = fmpy.simulate_fmu(fmu3, start_values=start, stop_time=2.0, output_interval=1e-3,
+                              output=["status", "gap_min"])
+        times, status = r["time"], r["status"]
+        assert r["gap_min"][-1] < -3e-3  # the diverged state's
+    elif master == "fmpy simulate":
+        import subprocess
+        import sys
+
+        out = tmp_path / "result.csv"
+        cli = "import sys; from fmpy.cli import main; sys.argv[0] = 'fmpy'; sys.exit(main())"  # the fmpy command
+        proc = subprocess.run([sys.executable, "-c", cli, "simulate", str(fmu3), "--start-values", "g0", "-0.0029",
+                               "--stop-time", "2", "--output-interval", "1e-3", "--output-variables", "status",
+                               "--output-file", str(out)], capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 0, proc.stderr[-2000:]
+        rows = np.genfromtxt(out, delimiter=",", names=True)
+        times, status = rows["time"], rows["status"]
+    else:
+        r = fmusim3_loop(unzipped3, start, stop=2.0)
+        assert r["status"] == OK
+        times, status = np.array([t for t, _ in r["rows"]]), np.array([st for _, st in r["rows"]])
+    assert 2 <= len(times) and times[-1] < 1.0 and status[-1] == 1 and (status[:-1] != 1).all()
+
+
+def test_a_quasi_static_divergence_at_initialisation_gives_every_master_a_row(unzipped3, fmu3):
+    """Issue 24.7: no balanced solution (or one deeper than max_penetration) at the initial inputs made
+    fmi3ExitInitializationMode return a Warning, and fmusim, which stops at any status above OK, wrote an empty
+    result. It is OK now, with status = 1 and the reason in 'message': fmusim's loop has the initial row (status 1)
+    and the first step's, which ends the run; fmpy the same."""
+    start = {"g0": 0.0, "max_penetration": 1e-5, **{k: START[k] for k in ("Omega", "imbalance")}}
+    r = fmusim3_loop(unzipped3, start, mode=2)
+    assert r["status"] == OK and r["rows"][0] == (0.0, 1) and len(r["rows"]) == 2 and r["rows"][-1][1] == 1
+    with Slave3(None, unzipped=str(unzipped3)) as i:
+        assert i.init(**start, mode=2) == OK
+        assert i.get("status") == 1 and "penetrates the casing" in i.get("message")
+        assert "penetrates the casing" in i.logged(level=WARNING)  # logged as a warning, logging off or on
+        assert i.get("gap_min") < -1e-5  # the outputs of that too-deep solution
+    res = fmpy.simulate_fmu(fmu3, start_values={**start, "mode": 2}, stop_time=1.0, output_interval=1e-3,
+                            output=["status"])
+    assert len(res) == 2 and (res["status"] == 1).all()
+
+
 def test_serialized_state_continues_bit_for_bit_in_a_fresh_instance(inst):
     assert inst.init(formulation=1, **START) == OK
     for _ in range(100):

@@ -1,5 +1,6 @@
-"""Every FMU keeps every variable it had before issue 24's re-layout (tests/fmu/data/model_descriptions/, written by
-the builders of commit 1d6655f): systems and SSP packages built on the old FMUs keep working.
+"""Every FMU keeps every variable it had before issue 24's re-layout, and `fmpy validate` finds nothing in any of
+them (the old descriptions: tests/fmu/data/model_descriptions/, written by the builders of commit 1d6655f):
+systems and SSP packages built on the old FMUs keep working.
 
 For each old variable, the new description has a variable of the same name with the same value reference,
 causality, variability, type, unit, min, max, start and nominal. New variables are allowed only after the old ones
@@ -114,10 +115,13 @@ def test_every_old_description_is_compared():
 def test_every_old_variable_is_kept(name, tmp_path):
     if "pythonfmu" in name:
         pytest.importorskip("pythonfmu")
+    from fmpy.validation import validate_fmu
+
     fmu = _builders()[name](tmp_path)
     with zipfile.ZipFile(fmu) as z:
         new = z.read("modelDescription.xml")
     assert differences(name, (DATA / f"{name}.xml").read_bytes(), new) == []
+    assert validate_fmu(str(fmu)) == []  # what `fmpy validate` reports
 
 
 def test_the_comparison_finds_a_changed_variable():
