@@ -21,7 +21,7 @@ does not declare it leaves a gap there (FMI allows gaps), so the flavours stay i
 ...                   element_description="output {k}")])
 >>> [(s.name, s.vr) for s in scalars(v)]
 [('u', 0), ('y[1]', 1), ('y[2]', 2), ('y[3]', 3)]
->>> c_name("casing_force.x"), tidy(5.8 * (0.4 + 0.5 * 0.6))
+>>> c_name("casing_force.x"), tidy(5.8476 * (0.4 + 0.5 * 0.6))
 ('CASING_FORCE_X', 4.09332)
 """
 
@@ -168,7 +168,7 @@ def c_name(name: str, suffix: bool = False) -> str:
 
 def tidy(x: float) -> float:
     """A bound computed from a parameter file written as a person reads it: 12 significant digits, which removes
-    the product's round-off (5.8 * 0.7 is 4.093319999999999, this 4.09332) and moves the value by less than
+    the product's round-off (5.8476 * 0.7 is 4.093319999999999, this 4.09332) and moves the value by less than
     1e-12 relative. For bounds that are modelling judgements (a range limit), never for a physical constant."""
     return float(f"{x:.12g}")
 

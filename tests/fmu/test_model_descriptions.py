@@ -7,7 +7,7 @@ causality, variability, type, unit, min, max, start and nominal. New variables a
 (value references above every old one). The GUID and the generation time are a build's and are not compared.
 
 One difference is permitted: a declared number may be written as a person reads it (issue 24.7: the maximum
-imbalance read 4.093319999999999, the product 5.8 * 0.7's round-off; now 4.09332), where it is the same number to
+imbalance read 4.093319999999999, the product 5.8476 * 0.7's round-off; now 4.09332), where it is the same number to
 1e-12 relative. And one file gains attributes: the pythonfmu spool's description was pythonfmu's own writer's;
 it is now the native spool's writer's (fmu_src/fmi/description.py), which also declares the parameters' nominal
 values (the native spool's, the same numbers) and the outputs' initial = "calculated" kept as before.
