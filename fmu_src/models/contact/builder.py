@@ -76,8 +76,9 @@ def model_data(model, variables) -> str:
     index = [vr[f"blade[{j}].{b}"] for b in kernel.OUT_BLADE_NAMES for j in range(1, nb + 1)]
     index += [vr[g] for g in kernel.OUT_GLOBAL_NAMES]
     spec = geometry_spec(model, 2, 0.0, 0.0, True)
-    wear = [vr[f"wear.{k}"] for k in ("depth_max", "depth_mean", "volume", "plastic_work", "lobes")]
-    wear += [vr[f"wear.harmonic[{h}]"] for h in range(1, cv.WEAR_HARMONICS + 1)]
+    # rr_surface_summary's values in the kernel's order (depth_max, ..., lobes, harmonic_1, ...)
+    wear = [vr[f"wear.harmonic[{n.rpartition('_')[2]}]" if n.startswith("harmonic_") else f"wear.{n}"]
+            for n in kernel.WEAR_NAMES]
     out = [
         f"const int OUTPUT_INDEX[{len(index)}] = {{{', '.join(map(str, index))}}};",
         f"const int WEAR_INDEX[{len(wear)}] = {{{', '.join(map(str, wear))}}};",

@@ -84,7 +84,6 @@ class RotorCasingContact(Fmi2Slave):
         super().__init__(**kwargs)
         self._resources = Path(self.resources) if self.resources else Path(__file__).parent
         self._manifest, self._lib, self._if = _load(self._resources)
-        itf = self._if
         self.version = self._manifest.get("library_version", "0")
         self.copyright = "rotorub developers"
         self._ref = self._lib.params.from_dict(self._manifest["parameter_values"])
@@ -117,8 +116,10 @@ class RotorCasingContact(Fmi2Slave):
         self._i_gmin = s["gap_min"]
         self._i_closure, self._i_offx, self._i_offy = s["clearance_closure"], s["casing_offset.x"], s["casing_offset.y"]
         self._i_clear = s["clearance_effective"]
-        wear = ["wear.depth_max", "wear.depth_mean", "wear.volume", "wear.plastic_work", "wear.lobes",
-                *(f"wear.harmonic[{h}]" for h in range(1, itf.WEAR_HARMONICS + 1))]
+        # the kernel's summary, in its order (kernel.WEAR_NAMES: depth_max, ..., lobes, harmonic_1, ...)
+        names = kern.WEAR_NAMES
+        wear = [f"wear.harmonic[{n.rpartition('_')[2]}]" if n.startswith("harmonic_") else f"wear.{n}" for n in names]
+        self._w_lobes, self._w_mean = names.index("lobes"), names.index("depth_mean")
         self._wear_index = np.array([s[k] for k in wear], dtype=np.intp)  # rr_surface_summary's order
         self._i_lobes = s["wear.lobes"]
         self._wear_out = np.zeros(len(wear))
@@ -534,8 +535,8 @@ class RotorCasingContact(Fmi2Slave):
             liner.struct.changed = 0
             self._sim["wear_valid"] = True
             self._rv[self._wear_index] = out  # else the outputs hold these values already
-            self._iv[self._i_lobes] = int(out[4])
-        self._rv[self._i_clear] = self._sim["g0"] - self._rv[self._i_closure] + out[1]
+            self._iv[self._i_lobes] = int(out[self._w_lobes])
+        self._rv[self._i_clear] = self._sim["g0"] - self._rv[self._i_closure] + out[self._w_mean]
 
     def _quasi_static(self, omega: float, me: float, h: float) -> tuple[bool, str]:
         sim, lib = self._sim, self._lib
