@@ -189,6 +189,22 @@ def build_native(b: NativeBuild, dest: str | Path, platforms: tuple[str, ...] | 
             "variables": len(shown if b.fmi == "3.0" else scalars(shown)), "size_bytes": out_file.stat().st_size}
 
 
+def stage_files(folder: Path, files: dict[str, Path | str | bytes]) -> list[Path]:
+    """Write ``files`` (name -> a path, file or folder, to copy; or the text or bytes to write) into ``folder``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    out = []
+    for name, what in files.items():
+        target = folder / name
+        if isinstance(what, Path):
+            (shutil.copytree if what.is_dir() else shutil.copy2)(what, target)
+        elif isinstance(what, bytes):
+            target.write_bytes(what)
+        else:
+            target.write_text(what)
+        out.append(target)
+    return out
+
+
 def package(out_file: Path, *, identifier: str, sources: dict[str, Path | str], c_files: tuple[str, ...],
             description_xml: bytes, documentation: dict[str, Path | str], platforms: tuple[str, ...] | None,
             fmi: str = "2.0") -> list[str]:
@@ -198,22 +214,11 @@ def package(out_file: Path, *, identifier: str, sources: dict[str, Path | str], 
     out_file.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="rotorub_native_") as tmp:
         root = Path(tmp) / "fmu"
-        src = root / "sources"
-        src.mkdir(parents=True)
-        for name, what in sources.items():
-            if isinstance(what, Path):
-                shutil.copy2(what, src / name)
-            else:
-                (src / name).write_text(what)
-        built = compile_platforms(src, c_files, identifier, root / "binaries", platforms, what=identifier, fmi=fmi)
+        stage_files(root / "sources", sources)
+        built = compile_platforms(root / "sources", c_files, identifier, root / "binaries", platforms,
+                                  what=identifier, fmi=fmi)
         (root / "modelDescription.xml").write_bytes(description_xml)
-        doc = root / "documentation"
-        doc.mkdir()
-        for name, what in documentation.items():
-            if isinstance(what, Path):
-                shutil.copy2(what, doc / name)
-            else:
-                (doc / name).write_text(what)
+        stage_files(root / "documentation", documentation)
         tmp_zip = out_file.with_suffix(".fmu.tmp")
         with zipfile.ZipFile(tmp_zip, "w", zipfile.ZIP_DEFLATED) as z:
             for f in sorted(root.rglob("*")):

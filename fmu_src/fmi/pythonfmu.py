@@ -20,6 +20,8 @@ import tempfile
 import zipfile
 from pathlib import Path
 
+from .package import stage_files
+
 DESCRIPTION_FILE = "model_description.xml"  # in the slave's resources at build time; not shipped
 
 
@@ -94,26 +96,11 @@ def build_pythonfmu(out_file: Path, *, identifier: str, script: Path, module_nam
     before, path_before = set(sys.modules), list(sys.path)
     with tempfile.TemporaryDirectory(prefix="rotorub_pythonfmu_") as tmp:
         stage = Path(tmp) / "stage"
-        stage.mkdir()
-        files = []
-        for name, what in {**resources, DESCRIPTION_FILE: description_xml}.items():
-            target = stage / name
-            if isinstance(what, Path):
-                (shutil.copytree if what.is_dir() else shutil.copy2)(what, target)
-            elif isinstance(what, bytes):
-                target.write_bytes(what)
-            else:
-                target.write_text(what)
-            files.append(target)
+        files = stage_files(stage, {**resources, DESCRIPTION_FILE: description_xml})
         staged = stage / f"{module_name}.py"
         shutil.copy2(script, staged)
         doc = Path(tmp) / "documentation"
-        doc.mkdir()
-        for name, what in documentation.items():
-            if isinstance(what, Path):
-                shutil.copy2(what, doc / name)
-            else:
-                (doc / name).write_text(what)
+        stage_files(doc, documentation)
         try:
             FmuBuilder.build_FMU(staged, dest=out_file, project_files=files, documentation_folder=doc,
                                  canGetAndSetFMUstate=True, canSerializeFMUstate=True)

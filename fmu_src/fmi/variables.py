@@ -179,6 +179,13 @@ def default_nominal(start: float, rng: tuple[float, float] | None) -> float:
     return abs(start) or min(1.0, max(abs(rng[0]), abs(rng[1])) if rng else 1.0) or 1.0
 
 
+def ranged(name: str, unit: str, rng: tuple[float, float], description: str, start: float,
+           causality: str = "parameter", variability: str = "fixed") -> Var:
+    """A Real parameter (or input) with its unit, declared range and start value, its nominal the default one."""
+    return Var(name, "Real", causality, variability, description, unit=unit, start=float(start), min=rng[0],
+               max=rng[1], nominal=default_nominal(float(start), rng))
+
+
 def as_plain(v: Var) -> dict:
     """A variable as JSON-ready data (what a pythonfmu slave reads from its manifest: it imports nothing of
     fmu_src)."""

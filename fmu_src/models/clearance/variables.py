@@ -13,7 +13,7 @@ starts warm at the initial speed (the engine was running there). The model is mo
 from __future__ import annotations
 
 from ...fmi.description import ModelInfo
-from ...fmi.variables import Var, default_nominal, numbered
+from ...fmi.variables import Var, numbered, ranged
 
 MODEL_IDENTIFIER = "TipClearance"
 DESCRIPTION = ("Closure of a fan's tip clearance from the spool speed: centrifugal growth c_centrifugal Omega^2 at "
@@ -43,11 +43,8 @@ def variables(values: dict | None = None) -> list[Var]:
     and of the input Omega 0, overridden by ``values``. New variables go at the end."""
     x = {**DEFAULTS, **(values or {})}
 
-    def par(name: str, unit: str, rng: tuple[float, float], text: str, causality: str = "parameter",
-            variability: str = "fixed") -> Var:
-        start = float(x.get(name, 0.0))
-        return Var(name, "Real", causality, variability, text, unit=unit, start=start, min=rng[0], max=rng[1],
-                   nominal=default_nominal(start, rng))
+    def par(name: str, unit: str, rng: tuple[float, float], text: str, *kind: str) -> Var:
+        return ranged(name, unit, rng, text, x.get(name, 0.0), *kind)
 
     return numbered([
         par("Omega", "rad/s", (0.0, 1e4), "Spin speed of the LP spool, held over each step", "input", "continuous"),

@@ -19,7 +19,7 @@ finite is refused (fmi2Discard, status 1: the spool stops; the run ends).
 from __future__ import annotations
 
 from ...fmi.description import ModelInfo
-from ...fmi.variables import Var, default_nominal, numbered
+from ...fmi.variables import Var, numbered, ranged
 
 MODEL_IDENTIFIER = "LPSpool"
 DESCRIPTION = (
@@ -63,11 +63,8 @@ def variables(values: dict | None = None) -> list[Var]:
     ...): declared so that a tool checks them, and refused outside. New variables go at the end."""
     x = {**DEFAULTS, **(values or {})}
 
-    def par(name: str, unit: str, rng: tuple[float, float], text: str, causality: str = "parameter",
-            variability: str = "fixed") -> Var:
-        start = float(x.get(name, 0.0))
-        return Var(name, "Real", causality, variability, text, unit=unit, start=start, min=rng[0], max=rng[1],
-                   nominal=default_nominal(start, rng))
+    def par(name: str, unit: str, rng: tuple[float, float], text: str, *kind: str) -> Var:
+        return ranged(name, unit, rng, text, x.get(name, 0.0), *kind)
 
     def out(name: str, unit: str, text: str) -> Var:
         return Var(name, "Real", "output", "continuous", text, unit=unit)
