@@ -65,6 +65,9 @@ def model_description(model: ModelInfo, variables: list[Var], *, fmi: str, token
     tags = {"fmi3" if three else "fmi2", flavour}
     own = declared(variables, tags)
     vars_ = own if three else scalars(own)
+    if three and [v.causality for v in own].count("independent") != 1:
+        raise ValueError(f"{model.identifier}: an FMI 3.0 description declares exactly one independent variable "
+                         "(fmu_src.fmi.variables.TIME in the model's list)")
     root = Element("fmiModelDescription", {
         "fmiVersion": fmi, "modelName": model.name or model.identifier,
         ("instantiationToken" if three else "guid"): token,

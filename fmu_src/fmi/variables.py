@@ -88,6 +88,11 @@ class Var:
         return range(self.vr, self.vr + self.size * self.stride, self.stride)
 
 
+# FMI 3.0's independent variable (every FMI 3.0 description declares exactly one): a model lists it where it wants
+# its value reference (after its FMI 2.0 variables: FMI 2.0 has no such variable and leaves the gap)
+TIME = Var("time", "Real", "independent", "continuous", "Simulation time", unit="s", only="fmi3")
+
+
 def check(variables: Iterable[Var]) -> None:
     """Refuse a list no build could write (one line naming the variable and what is wrong)."""
     seen: set[str] = set()

@@ -19,10 +19,11 @@ class ClearanceError(ValueError):
 
 
 def build_clearance_fmu(dest: str | Path = "fmus/native", platforms: tuple[str, ...] | None = None,
-                        **defaults) -> Path:
-    """Build ``dest/TipClearance.fmu``; keyword arguments override the start values of the parameters and of the
-    Omega input (a system whose spool starts turning: the closure at t0, and its thermal part warm there, are
-    then the engine's before a master's first exchange, in every master alike)."""
+                        fmi: str = "2.0", **defaults) -> Path:
+    """Build ``dest/TipClearance.fmu`` (FMI ``fmi``: the wear scenario uses "2.0"; "3.0" from the same wrappers);
+    keyword arguments override the start values of the parameters and of the Omega input (a system whose spool
+    starts turning: the closure at t0, and its thermal part warm there, are then the engine's before a master's
+    first exchange, in every master alike)."""
     from rotorub_model import __version__ as lib_version
 
     settable = {v.name: v for v in cv.variables() if v.settable}
@@ -32,6 +33,6 @@ def build_clearance_fmu(dest: str | Path = "fmus/native", platforms: tuple[str, 
             raise ClearanceError(f"clearance FMU: unknown parameter '{k}'; known: {', '.join(settable)}")
         if not (math.isfinite(float(x)) and v.min <= float(x) <= v.max):
             raise ClearanceError(f"clearance FMU: {k} = {x!r} out of range; accepted range [{v.min!r}, {v.max!r}]")
-    out = build_native(NativeBuild(model=cv.MODEL, variables=cv.variables(defaults), model_dir=HERE, facts=FACTS),
-                       dest, platforms, f"rotorub {lib_version}", lib_version)
+    out = build_native(NativeBuild(model=cv.MODEL, variables=cv.variables(defaults), model_dir=HERE, fmi=fmi,
+                                   facts=FACTS), dest, platforms, f"rotorub {lib_version}", lib_version)
     return Path(out["fmu"])

@@ -13,7 +13,7 @@ starts warm at the initial speed (the engine was running there). The model is mo
 from __future__ import annotations
 
 from ...fmi.description import ModelInfo
-from ...fmi.variables import Var, numbered, ranged
+from ...fmi.variables import TIME, Var, numbered, ranged
 
 MODEL_IDENTIFIER = "TipClearance"
 DESCRIPTION = ("Closure of a fan's tip clearance from the spool speed: centrifugal growth c_centrifugal Omega^2 at "
@@ -59,4 +59,5 @@ def variables(values: dict | None = None) -> list[Var]:
         Var("closure_thermal", "Real", "output", "continuous", "Thermal part (lagging the speed)", unit="m"),
         Var("status", "Integer", "output", "discrete", "0 = ok; 2 = bad parameter or input (call refused)"),
         Var("message", "String", "output", "discrete", "Cause of the last refused call"),
+        TIME,  # the FMI 3.0 build's independent variable (FMI 2.0: none, a gap)
     ])

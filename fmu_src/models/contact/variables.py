@@ -22,7 +22,7 @@ import math
 from dataclasses import dataclass
 
 from ...fmi.description import ModelInfo
-from ...fmi.variables import Var, numbered, tidy
+from ...fmi.variables import TIME, Var, numbered, tidy
 
 MODEL_IDENTIFIER = "RotorCasingContact"
 MODEL_NAME = "RotorCasingContact"
@@ -282,7 +282,7 @@ def variables(d: Defaults, mode: str = "transient") -> list[Var]:
             "Clearance the engine keeps: g0 - clearance_closure + the mean worn depth (what a performance model "
             "pays for)", unit="m", display_unit="mm"))
     # the FMI 3.0 FMU's own: after every FMI 2.0 variable, as they have always been
-    add(Var("time", "Real", "independent", "continuous", "Simulation time", unit="s", only="fmi3"))
+    add(TIME)
     add(Var("n_blades", "UInt64", "structuralParameter", "fixed",
             "Number of blades: the size of the per-blade arrays, fixed by the parameter file the FMU was built with "
             "(another blade count: rebuild with --params)", start=d.n_blades, min=d.n_blades, max=d.n_blades,

@@ -19,7 +19,7 @@ from pathlib import Path
 from ...fmi.description import model_description, xml_bytes
 from ...fmi.package import NativeBuild, build_native, documentation_html, guid_of
 from ...fmi.pythonfmu import build_pythonfmu, pythonfmu_version
-from ...fmi.variables import as_plain
+from ...fmi.variables import as_plain, declared, scalars
 from . import variables as sv
 
 HERE = Path(__file__).resolve().parent  # fmu_src/models/spool/
@@ -55,12 +55,13 @@ def _values(defaults: dict) -> dict:
 
 
 def build_native_spool_fmu(dest: str | Path = "fmus/native", platforms: tuple[str, ...] | None = None,
-                           **defaults) -> Path:
-    """Build ``dest/LPSpool.fmu`` in C; keyword arguments override the parameters' start values."""
+                           fmi: str = "2.0", **defaults) -> Path:
+    """Build ``dest/LPSpool.fmu`` in C (FMI ``fmi``: the engine's systems use "2.0"; "3.0" from the same wrappers);
+    keyword arguments override the parameters' start values."""
     from rotorub_model import __version__ as lib_version
 
     out = build_native(NativeBuild(model=sv.MODEL, variables=sv.variables(_values(defaults)), model_dir=HERE,
-                                   facts=FACTS), dest, platforms, f"rotorub {lib_version}", lib_version)
+                                   fmi=fmi, facts=FACTS), dest, platforms, f"rotorub {lib_version}", lib_version)
     return Path(out["fmu"])
 
 
@@ -69,12 +70,13 @@ def build_spool_fmu(dest: str | Path = "fmus", **defaults) -> Path:
     (J, c_w, Omega0, Omega1, t_ramp_start, t_ramp, dt_max). Needs pythonfmu."""
     version = pythonfmu_version()
     variables = sv.variables(_values(defaults))
-    plain = [as_plain(v) for v in variables]
+    own = scalars(declared(variables, ("fmi2", "pythonfmu")))  # what the slave registers
+    plain = [as_plain(v) for v in own]
     tag = hashlib.sha256(SLAVE.read_bytes() + json.dumps(plain).encode() + version.encode()).hexdigest()[:10]
     guid = guid_of("pythonfmu", tag)
     md = model_description(sv.MODEL, variables, fmi="2.0", token=guid, flavour="pythonfmu",
                            generation_tool=f"rotorub (PythonFMU {version})", version="1.0")
-    doc = documentation_html(sv.MODEL_IDENTIFIER, "FMI 2.0 co-simulation (pythonfmu)", sv.DESCRIPTION, variables,
+    doc = documentation_html(sv.MODEL_IDENTIFIER, "FMI 2.0 co-simulation (pythonfmu)", sv.DESCRIPTION, own,
                              "<p>The same model as the native LPSpool.fmu (which the engine system uses); this one "
                              "is the example of a slave written in Python. Needs a CPython 3.10+ host (pythonfmu); "
                              "no other package.</p>")

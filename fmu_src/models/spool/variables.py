@@ -19,7 +19,7 @@ finite is refused (fmi2Discard, status 1: the spool stops; the run ends).
 from __future__ import annotations
 
 from ...fmi.description import ModelInfo
-from ...fmi.variables import Var, numbered, ranged
+from ...fmi.variables import TIME, Var, numbered, ranged
 
 MODEL_IDENTIFIER = "LPSpool"
 DESCRIPTION = (
@@ -95,6 +95,7 @@ def variables(values: dict | None = None) -> list[Var]:
         Var("message", "String", "output", "discrete",
             "Cause of the last refused call (the text also sent to the FMI logger); empty after a step that "
             "succeeded"),
+        TIME,  # the FMI 3.0 build's independent variable (FMI 2.0: none, a gap)
     ])
 
 
