@@ -4,7 +4,7 @@
                                     [--kinds simulate,slaves] [--timeout 300]
 
 The cause it was written to show (pythonfmu 0.7.0's linux64 binary writes into a block it freed at
-process exit) and the fix (fmu_src/build/pythonfmu_fmu.py patches that binary) are in fmu_src/build/pythonfmu_fmu.py's
+process exit) and the fix (fmu_src/fmi/pythonfmu.py patches that binary) are in fmu_src/fmi/pythonfmu.py's
 _patch_exit_double_release; the native FMU has no such code. Either flavour can be given with --fmu.
 
 Runs --n fresh Python processes of each kind (at most --jobs at once) and counts the

@@ -2,7 +2,7 @@
 
     python benchmarks/bench_fmu.py [--fmu fmus/RotorCasingContact.fmu ...] [--steps 1000000] [--t-end 1.5]
 
-Scenario (the one tests/test_fmu.py checks against the library): 3D contact, g0 = 0.5 mm,
+Scenario (the one tests/fmu/test_contact_model.py checks against the library): 3D contact, g0 = 0.5 mm,
 Omega = 3.3 omega_ref held constant, imbalance ramped from 0 to the reference m*e over 1 s
 by the master (held over each communication step), 1.5 s simulated.
 

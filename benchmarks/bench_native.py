@@ -7,7 +7,7 @@ and through fmpy against the pythonfmu FMU, all measured in one run.
 Scenario: 3D contact, g0 = 0.5 mm, Omega = 3.3 omega_ref, the reference imbalance from t = 0, h = 1 ms
 (two internal steps per communication step), every Real output read after every step.
 
-* C host: fmu_src/native_host/fmu_host.c (compiled here with the system compiler) dlopens the FMU's
+* C host: fmu_src/masters/hosts/fmu_host.c (compiled here with the system compiler) dlopens the FMU's
   binary in a process with no Python, and times instantiate .. end of the first step, then the
   stepping loop (set Omega and imbalance, fmi2DoStep, fmi2GetReal of every Real output);
 * bare loop: benchmarks/bare_loop.c, the same substeps (the kernel's own step, three mat-vecs and the
@@ -73,7 +73,7 @@ def main(argv: list[str] | None = None) -> int:
         if cc is None:
             print("no system C compiler to build the C host", file=sys.stderr)
             return 2
-        subprocess.run([cc, "-O2", "-o", str(host), str(REPO / "fmu_src" / "native_host" / "fmu_host.c"), "-ldl"],
+        subprocess.run([cc, "-O2", "-o", str(host), str(REPO / "fmu_src" / "masters" / "hosts" / "fmu_host.c"), "-ldl"],
                        check=True)
         args = [str(host), "-d", str(fmu_dir), "-n", str(ns.steps), "-s", repr(h), "-b", "-q",
                 "-p", f"{vr['g0']}={g0!r}", "-u", f"{vr['Omega']}={omega!r}", "-u", f"{vr['imbalance']}={me!r}"]

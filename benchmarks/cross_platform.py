@@ -3,7 +3,7 @@
     .venv/bin/python benchmarks/cross_platform.py [--steps N]
 
 Builds RotorCasingContact.fmu for linux64, aarch64-linux and win64 (ziglang), builds the C host
-(fmu_src/native_host/fmu_host.c) for each platform, and runs the same scenario in each: a 3D rub at the
+(fmu_src/masters/hosts/fmu_host.c) for each platform, and runs the same scenario in each: a 3D rub at the
 section-6 speed from rest with the reference imbalance, every blade's normal and friction force, the casing
 force, the friction torque, the disk displacement, the smallest gap, the blades in contact, N steps of 1 ms.
 aarch64-linux runs under qemu-aarch64 (Debian: apt install qemu-user libc6-arm64-cross), win64 under wine
@@ -37,8 +37,8 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from fmu_src.build.native_fmu import build_native_fmu  # noqa: E402
-from fmu_src.harness import native_host  # noqa: E402
+from fmu_src.masters import native_host  # noqa: E402
+from fmu_src.models.contact.builder import build_native_fmu  # noqa: E402
 
 PLATFORMS = ("linux64", "aarch64-linux", "win64")
 

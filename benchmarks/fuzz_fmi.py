@@ -5,8 +5,8 @@ in a fresh process, so that a crash or a hang is observed instead of suffered.
                                           [--jobs 2] [--list]
     .venv/bin/python benchmarks/fuzz_fmi.py --case NAME --fmu PATH [--other PATH]   # one case (the children)
 
-Without --fmu both FMUs are built for linux64 into a temporary folder (fmu_src.build.native_fmu and
-fmu_src.engine.spool; the binaries are cached). Every case drives the FMU's binary through fmpy's
+Without --fmu both FMUs are built for linux64 into a temporary folder (fmu_src.models.contact.builder and
+fmu_src.models.spool.builder; the binaries are cached). Every case drives the FMU's binary through fmpy's
 FMU2Slave (the status a call returns is taken as it is; fmpy's exception for a status above fmi2Warning
 is caught) with a logger that records (status, message), and makes one call under test, the probe (a
 few cases make two: fmi2DeSerializeFMUstate then fmi2SetFMUstate). What is tried, per FMU (the value
@@ -29,7 +29,7 @@ cases are generated from its modelDescription.xml):
   fmi2GetFMUstate into an existing state or a NULL pointer, a state of the other FMU (contact vs spool,
   in memory and serialized), serialized states truncated, extended, garbage, or with one field corrupted
   (magic, GUID, phase, sizes, time, a value out of range, the model's data);
-* the divergence rule (fmu_src/FMU.md): the diverging step is fmi2Discard with a message and
+* the divergence rule (fmu_src/models/contact/FMU.md): the diverging step is fmi2Discard with a message and
   fmi2GetBooleanStatus(fmi2Terminated) is then true; a further fmi2DoStep is fmi2Error; a rollback
   (fmi2SetFMUstate) or fmi2Reset goes on; no step returns fmi2OK in a state past the divergence limit;
 * the rest: fmi2SetDebugLogging with unknown categories, fmi2Get*Status kinds that are not provided
@@ -87,7 +87,7 @@ ERR_NOMSG, SILENT, FATAL_, CRASH, HANG = "error, no message", "SILENT OK", "FATA
 REFUSED = (ERR_MSG, DIS_MSG)
 ALLOWED_ALL = (ALLOWED, DIS_ALLOWED)
 
-# how each model is made to diverge, and how a run goes on after a rollback (fmu_src/FMU.md, "Divergence")
+# how each model is made to diverge, and how a run goes on after a rollback (models/contact/FMU.md, "Divergence")
 RECIPES = {
     "RotorCasingContact": dict(params={"max_penetration": 1e-5, "g0": 0.0}, inputs={},
                                recover={"g0": 1e-3}),
@@ -1254,8 +1254,8 @@ def summary(label: str, rows: list[dict]) -> str:
 
 def build_fmus(dest: Path) -> list[str]:
     sys.path.insert(0, str(REPO))
-    from fmu_src.build.native_fmu import build_native_fmu
-    from fmu_src.engine.spool import build_native_spool_fmu
+    from fmu_src.models.contact.builder import build_native_fmu
+    from fmu_src.models.spool.builder import build_native_spool_fmu
     contact = build_native_fmu(dest / "contact", platforms=("linux64",))["fmu"]
     spool = build_native_spool_fmu(dest / "spool", platforms=("linux64",))
     return [str(contact), str(spool)]

@@ -343,12 +343,13 @@ def cmd_reproduce(ns: argparse.Namespace) -> dict:
         except (LookupError, ImportError) as exc:
             raise ParameterError(f"reproduce: the FMU part needs the fmu extra ({exc}); "
                                  "pip install -e '.[fmu]', or run with --no-fmu") from None
-        s.update(run_fmu_part(model, ns.out, s, quick=ns.quick, fmu_dir=ns.fmu_dir, params_file=ns.params))
+        part = run_fmu_part(model, ns.out, s, quick=ns.quick, fmu_dir=ns.fmu_dir, params_file=ns.params)
+        s.update(part["summary"])
         from ..results import write_json
         from .report import write_report
 
         write_json(Path(ns.out) / "summary.json", s)
-        write_report(ns.out, s)
+        write_report(ns.out, s, sections=[part["markdown"]])
     keys = ("fmu_vs_library_max_rel_diff", "coupled_run")
     return {"paper_facts": s["paper_facts"], **{k: s[k] for k in keys if k in s},
             "written": str(Path(ns.out) / "summary.json")}

@@ -190,65 +190,6 @@ def _inputs_section(summary: dict) -> list[str]:
             f"| package | rotorub_model {inp['package_version']}" + (f" ({libs})" if libs else "") + " |"]
 
 
-def _fmu_section(summary: dict) -> list[str]:
-    h = summary["harnesses"]
-    tr, ru, qs = h["transient"], h["run_up"], h["quasi_static"]
-    rows = [
-        ("transient 2D (section 6), F_N", tr["2D"]["max_rel_diff_F_N_vs_library"],
-         f"diverged: {tr['2D']['diverged']}, blades at 1 s: {tr['2D']['blades_in_contact_at_1s']}"),
-        ("transient 3D (section 6), F_N", tr["3D"]["max_rel_diff_F_N_vs_library"],
-         f"diverged: {tr['3D']['diverged']}, blades at 1 s: {tr['3D']['blades_in_contact_at_1s']}"),
-        ("run-up through the first critical, F_N", ru["max_rel_diff_F_N_vs_library"],
-         f"peak response at Ω = {_fmt(ru['speed_of_peak_response'])}, max F_N {_fmt(ru['max_normal_force_N'])} N"),
-    ]
-    for f, v in qs["vs_library"].items():
-        rows.append((f"quasi-static map {f}, largest real part", v["max_real_max_rel_diff"],
-                     f"{v['cells_same_blades_in_contact']}/{v['cells']} cells same contact state, "
-                     f"{v['cells_other_branch']} on another branch, {v['cells_solved_by_one_only']} solved by one "
-                     f"side only; same stability verdict in {v['same_stability_verdict_fraction']:.0%}"))
-    lines = ["", "## FMU against the library", "",
-             f"Largest relative difference: **{summary['fmu_vs_library_max_rel_diff']:.2e}** "
-             f"({summary.get('fmu_vs_library_note', '')}).", "",
-             "| harness (through the FMU, fmpy) | max rel. diff vs library | notes |", "|---|---|---|"]
-    lines += [f"| {a} | {b:.2e} | {c} |" for a, b, c in rows]
-    fl = summary.get("fmu_flavours")
-    if fl:
-        lines += ["", "## The two FMU flavours on the same scenario", "",
-                  f"Section-6 point, {fl['t_end_s']:g} s, h = {fl['h_s'] * 1e3:g} ms, inputs held over each step "
-                  "(native C FMU, pythonfmu FMU, library `run_transient(hold=h)`).", "",
-                  "| formulation | native vs pythonfmu | bit for bit | native vs library | wall time native / "
-                  "pythonfmu [s] |", "|---|---|---|---|---|"]
-        for f in ("2D", "3D"):
-            v = fl[f]
-            lines.append(f"| {f} | {v['native_vs_pythonfmu']:.1e} | {v['bit_identical']} | "
-                         f"{v['native_vs_library']:.1e} | {v['seconds']['native']:.3f} / "
-                         f"{v['seconds']['pythonfmu']:.3f} |")
-    c = summary.get("coupled_run")
-    if c:
-        lines += ["", "## Coupled engine scenario (LP spool FMU + contact FMU)", "",
-                  "| quantity | value |", "|---|---|"]
-        lines += [f"| {_label(k)} | {_fmt(v)} |" for k, v in c.items() if not isinstance(v, dict | list)]
-    w = summary.get("coupled_wear_run")
-    if w:
-        lines += ["", "## Engine scenario with wear (spool + clearance closure + contact with its liner)", "",
-                  f"A run-up through the first critical speed with a quarter of the reference imbalance "
-                  f"({w['imbalance_kg_m'] * 1e3:g} kg·mm) and g0 = {w['g0_mm']:g} mm: held at g0 the blades never "
-                  f"touch (wear {w['no_closure_wear_depth_max_mm']:g} mm); the engine's closure (up to "
-                  f"{w['closure_max_mm']:.3g} mm) makes them rub from t = {_fmt(w['t_first_contact_s'])} s and cut "
-                  f"the liner {w['wear_depth_max_mm'] * 1e3:.1f} µm deep ({w['wear_volume_mm3']:.4g} mm³). At the "
-                  f"end the engine keeps {w['clearance_effective_end_mm']:.4g} mm where an unworn liner would leave "
-                  f"{w['clearance_without_wear_end_mm']:.4g} mm: {w['clearance_penalty_mm'] * 1e3:.1f} µm more, "
-                  f"about {w['fuel_burn_penalty_estimate_pct']:.2g} % fuel burn by the rule of thumb "
-                  f"({w['fuel_burn_rule']}). The package runs the same in fmpy, in libcosim (largest relative "
-                  f"difference {_fmt(_largest(w.get('libcosim_max_rel_diff')))}) and in the C master "
-                  f"({_fmt(_largest(w.get('native_host_max_rel_diff')))})."]
-    return lines
-
-
-def _largest(d: dict | None) -> float | None:
-    return None if not d else max(d.values())
-
-
 def _wear_section(w: dict) -> list[str]:
     lines = ["", "## The section-6 rub against an abradable liner", "",
              f"Not in the paper (its casing is rigid): the same transient at Ω = {w['speed']:.4g}, g0 = "
@@ -304,8 +245,9 @@ def _discretisation_section(d: dict) -> list[str]:
     ]
 
 
-def write_report(out: str | Path, summary: dict) -> Path:
-    """Write out/report.md from the main job's summary (figures by relative path)."""
+def write_report(out: str | Path, summary: dict, sections: tuple[str, ...] | list[str] = ()) -> Path:
+    """Write out/report.md from the main job's summary (figures by relative path); ``sections``: markdown another
+    package's part of the job wrote about its own results (the FMU half's), inserted as it is before the figures."""
     out = Path(out)
     lines = [
         "# rotorub — reproduction of Parent, Thouverez & Chevillot (EURODYN 2014)",
@@ -335,8 +277,8 @@ def write_report(out: str | Path, summary: dict) -> Path:
         lines += _continuation_section(summary["continuation"])
     if "blade_discretisation" in summary:
         lines += _discretisation_section(summary["blade_discretisation"])
-    if "harnesses" in summary:
-        lines += _fmu_section(summary)
+    for section in sections:
+        lines += section.rstrip("\n").split("\n")
     lines += ["", "## Figures", ""]
     for title, rel in [*FIGURES, *[tuple(x) for x in summary.get("figures_extra", [])]]:
         if (out / rel).exists():

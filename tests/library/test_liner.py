@@ -243,7 +243,7 @@ def test_a_wearing_run_creates_no_energy(undamped):
 def test_the_kernels_constants_are_the_librarys_and_the_interfaces():
     from pathlib import Path
 
-    from fmu_src import interface
+    from fmu_src.models.contact import variables as interface
 
     header = (Path(kernel.__file__).parent / "rotorub_kernel.h").read_text()
     assert f"#define RR_WEAR_HARMONICS {kernel.WEAR_HARMONICS} " in header

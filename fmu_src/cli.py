@@ -1,0 +1,74 @@
+"""The FMU side's entry points for the ``rotorub`` CLI, found through entry points (the library never imports this
+package): ``build-fmu`` (group ``rotorub.commands``) and the FMU half of ``reproduce`` (group ``rotorub.reproduce``,
+reproduce.py next to this file)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+
+def _add_build_args(sp: argparse.ArgumentParser) -> None:
+    sp.add_argument("--native", action="store_true",
+                    help="the native C FMU (no Python on the host) instead of the pythonfmu one")
+    sp.add_argument("--fmi3", action="store_true",
+                    help="with --native: the FMI 3.0 co-simulation FMU (fmus/native-fmi3/: arrays per blade, early "
+                         "return at a first contact) instead of the FMI 2.0 one")
+    sp.add_argument("--mode", default="transient", choices=["transient", "quasi_static"],
+                    help="default of the mode parameter, and the output dependencies the FMU declares")
+    sp.add_argument("--platforms", nargs="+", default=None,
+                    help="platforms to build (native: linux64 win64 darwin64 aarch64-darwin; pythonfmu kernel: "
+                         "linux64 win64); default: this one plus what ziglang can cross-compile")
+
+
+def build(dest: str | Path, params: str | Path | None = None, native: bool = False, mode: str = "transient",
+          platforms: tuple[str, ...] | None = None, fmi3: bool = False) -> dict:
+    """Build one flavour of RotorCasingContact.fmu into ``dest`` and write its cross-check kit next to it
+    (``fmi3``: the native FMI 3.0 FMU and its kit)."""
+    from rotorub_model.structure.params import load_parameters
+
+    from .fmi.compile import NativeBuildError
+    from .models.contact import crosscheck
+    from .models.contact.builder import build_fmu, build_native_fmu
+
+    if fmi3 and not native:
+        raise NativeBuildError("--fmi3: the FMI 3.0 FMU is the native one: add --native (pythonfmu 0.7 writes FMI "
+                               "2.0 only)")
+    if native:
+        out = build_native_fmu(dest, params, platforms, mode, fmi="3.0" if fmi3 else "2.0")
+    else:
+        out = build_fmu(dest, params, platforms, mode)
+    kit = crosscheck.write_kit(Path(out["fmu"]).parent, load_parameters(params) if params else None,
+                               fmi="3.0" if fmi3 else "2.0")
+    return {**out, "crosscheck_kit": sorted(str(p) for p in kit.values())}
+
+
+def _run_build(ns: argparse.Namespace) -> dict:
+    from rotorub_model.errors import ParameterError
+    from rotorub_model.kernel.compiler import CompilerError
+
+    from .fmi.compile import NativeBuildError
+    from .fmi.pythonfmu import BuildError
+
+    default = Path("fmus") / (("native-fmi3" if ns.fmi3 else "native") if ns.native else "")
+    dest = default if ns.out == "out/build-fmu" else Path(ns.out)
+    try:
+        return build(dest, ns.params, ns.native, ns.mode, tuple(ns.platforms) if ns.platforms else None, ns.fmi3)
+    except (BuildError, NativeBuildError, CompilerError) as exc:
+        raise ParameterError(f"build-fmu: {exc}") from None
+
+
+def reproduce_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: str | Path = "fmus",
+                       params_file: str | Path | None = None, progress: bool = True) -> dict:
+    """The FMU half of ``rotorub reproduce`` (reproduce.py): returns ``{"summary": ..., "markdown": ...}``, the
+    additions to the summary and the report's section about them."""
+    from .reproduce import run_fmu_part
+
+    return run_fmu_part(model, out, summary, quick, fmu_dir=fmu_dir, params_file=params_file, progress=progress)
+
+
+# (name, help, add_arguments, run): what rotorub_model.app.cli registers for each entry point
+BUILD_FMU = ("build-fmu", "package the contact model as an FMI 2.0 co-simulation FMU: fmus/RotorCasingContact.fmu "
+             "(pythonfmu) or, with --native, fmus/native/RotorCasingContact.fmu (C, no Python on the host); with "
+             "--native --fmi3, the FMI 3.0 one in fmus/native-fmi3/",
+             _add_build_args, _run_build)

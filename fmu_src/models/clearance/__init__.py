@@ -1,0 +1,1 @@
+"""TipClearance: the closure of a fan's tip clearance from the spool speed (native C)."""

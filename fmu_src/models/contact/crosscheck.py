@@ -1,0 +1,124 @@
+"""RotorCasingContact's FMI cross-check kit, written next to each FMU (the files: fmu_src/fmi/crosscheck.py):
+
+* ``RotorCasingContact_in.csv``: every input of the FMU, one row per communication point: ``time, Omega,
+  imbalance, clearance_closure, casing_offset.x, casing_offset.y`` (a run-up through the first critical speed
+  with the reference imbalance; the engine's inputs at their start values, 0);
+* ``RotorCasingContact_ref.csv``: the reference outputs at the same points (FMI 3.0 kit: the per-blade outputs in
+  the array columns, ``blade.F_N[1]``, ...);
+* ``RotorCasingContact_ref.opt`` and ``ReadMe.txt``.
+
+Every parameter keeps its default (the FMU's start values: g0 = 1 mm, 3D, transient), so any importing tool can
+run it without setting anything but the inputs. The reference comes from the library (``run_transient(hold=h)``),
+which every flavour reproduces to round-off. fmu_src/masters/crosscheck.py runs an FMU against it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ...fmi import crosscheck as kit
+from ...fmi.variables import declared, scalars
+from . import variables as cv
+
+NAME = cv.MODEL_IDENTIFIER
+RUN = {"speed_from": 3.2, "speed_to": 3.8, "duration": 2.0, "h": 1e-3}  # normalised speeds; s
+
+
+def outputs(n_blades: int = 10) -> tuple[str, ...]:
+    """The reference's outputs, by their FMI 2.0 names."""
+    return ("friction_torque", "gap_min", "n_contact", "disk_displacement.x", "disk_displacement.y",
+            "casing_force.x", "casing_force.y", "casing_force.z") + tuple(f"blade[{j}].F_N"
+                                                                          for j in range(1, n_blades + 1))
+
+
+OUTPUTS = outputs()
+
+
+def _omega(w_ref: float):
+    a, b, d = RUN["speed_from"], RUN["speed_to"], RUN["duration"]
+    return lambda t: w_ref * (a + (b - a) * min(max(t / d, 0.0), 1.0))
+
+
+def _variables(params):
+    return cv.variables(cv.Defaults.from_parameters(params))
+
+
+def reference(params=None) -> dict[str, np.ndarray]:
+    """Every input (by name) and the reference outputs (FMI 2.0 names) at the communication points 0, h, ..."""
+    from rotorub_model.analyses.transient import run_transient
+    from rotorub_model.contact import make_contact
+    from rotorub_model.structure.model import build_model
+    from rotorub_model.structure.params import reference_parameters
+
+    p = params or reference_parameters()
+    m = build_model(p)
+    w = _omega(p.normalisation.omega_ref)
+    h, T = RUN["h"], RUN["duration"]
+    r = run_transient(m, make_contact(m, "3D"), w, t_end=T, t_ramp=0.0, me=p.imbalance.me, record_dt=h, hold=h)
+    n = len(r.t)
+    t = np.concatenate([[0.0], r.t])
+    o = r.outputs
+    out = {"time": t}
+    # every input of the FMU: the run's speed and imbalance, the others held at their start values
+    for v in scalars(declared(_variables(p), ("fmi2", "native"))):
+        if v.causality == "input":
+            out[v.name] = np.full(n + 1, float(v.start))
+    out["Omega"] = np.array([w(x) for x in t])
+    out["imbalance"] = np.full(n + 1, p.imbalance.me)
+    zero = np.zeros(1)
+    out["friction_torque"] = np.concatenate([zero, o["friction_torque"]])
+    out["gap_min"] = np.concatenate([[p.contact.g0], o["gap"].min(axis=(1, 2))])
+    out["n_contact"] = np.concatenate([zero, (o["F_N"] > 0).sum(axis=1)])
+    for k, ax in enumerate("xy"):
+        out[f"disk_displacement.{ax}"] = np.concatenate([zero, o["disk_fixed"][:, k]])
+    for k, ax in enumerate("xyz"):
+        out[f"casing_force.{ax}"] = np.concatenate([zero, o["casing_force_fixed"][:, k]])
+    for j in range(p.blades.count):
+        out[f"blade[{j + 1}].F_N"] = np.concatenate([zero, o["F_N"][:, j]])
+    return out
+
+
+def columns3(params=None) -> dict[str, str]:
+    """The kit's FMI 2.0 column names -> the FMI 3.0 FMU's (``blade[j].F_N`` is ``blade.F_N[j]``)."""
+    from rotorub_model.structure.params import reference_parameters
+
+    return kit.element_columns(_variables(params or reference_parameters()))
+
+
+def write_kit(dest: str | Path, params=None, fmi: str = "2.0") -> dict[str, Path]:
+    """Write the kit into ``dest`` (next to the FMU). ``fmi = "3.0"``: the FMI 3.0 FMU's kit, the same run and
+    numbers with the array elements as its columns (blade.F_N[1], ...)."""
+    from rotorub_model.structure.params import reference_parameters
+
+    p = params or reference_parameters()
+    ref = reference(p)
+    inputs = [v.name for v in scalars(declared(_variables(p), ("fmi2", "native"))) if v.causality == "input"]
+    outs = outputs(p.blades.count)
+    rename = columns3(p) if fmi == "3.0" else {}
+    readme = f"""{NAME}: FMI cross-check kit (co-simulation)
+
+A run-up with blade-tip / casing rub: the spin speed Omega rises linearly from {RUN['speed_from']} to
+{RUN['speed_to']} x omega_ref (through the first critical speed) in {RUN['duration']} s, the imbalance is held at
+the reference value, the engine's inputs ({', '.join(i for i in inputs if i not in ('Omega', 'imbalance'))}) at 0,
+every parameter keeps its default (3D contact, transient mode, g0 = 1 mm).
+
+Run {NAME}.fmu from 0 to {RUN['duration']} s with a fixed communication step of {RUN['h']} s, the inputs of
+{NAME}_in.csv (every input of the FMU, one row per communication point: hold each value over the step that starts
+there, or interpolate linearly: the same), and compare the outputs with {NAME}_ref.csv: they agree to round-off
+(the FMU computes them in double precision with the same operations as the reference; 1e-9 relative to
+each column's largest value is a generous bound: measured, about 1e-11). The native FMU's binaries give
+identical numbers on every platform they were run on (linux64, aarch64-linux under qemu, win64 under
+wine): the kernel has its own elementary functions. The outputs at t = 0 are those after initialisation.
+
+Reference written by rotorub (fmu_src/models/contact/crosscheck.py) from the library's run_transient(hold=h).
+""" + ("""
+FMI 3.0: the per-blade outputs are arrays of n_blades elements; column blade.F_N[j] is element j of the
+array blade.F_N (fmi3GetFloat64 of its value reference with nValues = n_blades). Instantiate without early
+return (earlyReturnAllowed = false) to take the communication steps of this table; with early return the
+same run, continued from each early return to the next communication point, gives the same numbers here
+(the step's remainder is a whole number of the same internal substeps).
+""" if fmi == "3.0" else "")
+    return kit.write_kit(dest, NAME, ref["time"], {k: ref[k] for k in inputs},
+                     {rename.get(c, c): ref[c] for c in outs}, RUN["h"], readme)

@@ -1,0 +1,43 @@
+/*
+ * model.h: what RotorCasingContact's model (model.c) takes from the data the build generates into model_data.c
+ * from the parameter file (fmu_src/models/contact/builder.py): the structure's matrices, the contact geometry's
+ * ingredients and where the kernel's outputs go. Its value references are variables.h's (VR_<NAME>, generated
+ * from fmu_src/models/contact/variables.py), as are its enumerations' values (FORMULATION_3D, MODE_TRANSIENT,
+ * LINER_ABRADABLE, ...).
+ */
+#ifndef ROTORUB_CONTACT_MODEL_H
+#define ROTORUB_CONTACT_MODEL_H
+
+#include "fmu_model.h"
+#include "rotorub_kernel.h"
+#include "variables.h"
+
+/* what this model writes beyond fmu_model.h's defaults */
+#define MODEL_HAS_CHECK_SET     /* g0 >= -max_penetration, also when g0 is tuned during the run */
+#define MODEL_HAS_STEP_TO_EVENT /* FMI 3.0 early return at a first contact */
+#define MODEL_HAS_TIME_ADVANCED /* a divergence reports the substep it reached */
+
+typedef struct {
+    int n;                 /* generalised coordinates */
+    int nb;                /* blades */
+    /* structure, rotating frame: M q'' + (D + W G1) q' + (K + W^2 (S2 + N2) + W C1) q = F_nl + me W^2 f_unit */
+    const double *M, *D, *K, *G1, *C1, *N2, *S2, *f_unit;
+    /* contact geometry ingredients (rr_geometry_spec but theta, chord, np, rotations) */
+    double r_tip, stagger, z_cg;
+    int blade_dof0, n_ritz, casing_dof0, n_modes;
+    const double *psi_tip;
+    const int *modes;
+    const double *T, *Rot; /* (3, n) fan-disk translation and rotation */
+} model_data;
+
+extern const model_data MODEL_DATA;
+
+/* where rr_surface_summary's RR_WEAR_OUT values go (RR_WEAR_LOBES: the Integer array) */
+extern const int WEAR_INDEX[];
+extern const double BLADE_THICKNESS; /* [m]: a tip's footprint on the liner is this x the chord */
+/* where the kernel's outputs of a state (its order, RR_N_OUT(nb)) go in the Real value array */
+extern const int OUTPUT_INDEX[];
+
+enum { STATUS_UNSTABLE = 3 }; /* quasi_static: the balanced solution is unstable */
+
+#endif
