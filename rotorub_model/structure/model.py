@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .blades import bladed_disk_matrices
+from .blades import bladed_disk_matrices, check_mistuning
 from .casing import casing_matrices
 from .frames import MATRIX_KEYS, Matrices
 from .params import Parameters, from_dict, reference_parameters, to_dict
@@ -50,6 +50,7 @@ class Model:
     f_tangential: np.ndarray  # imbalance force for m e = 1 kg m at dOmega/dt = 1 rad/s^2
     f_euler: np.ndarray  # inertia load of the blades at dOmega/dt = 1 rad/s^2
     slices: dict[str, slice]
+    mistuning: tuple[float, ...] | None = None  # per-blade stiffness deviations (build_model); None: tuned
 
     @property
     def n_dofs(self) -> int:
@@ -115,11 +116,14 @@ def _place(n: int, parts: list[tuple[Matrices, np.ndarray]]) -> dict[str, np.nda
     return out
 
 
-def build_model(params: Parameters | None = None) -> Model:
-    """Assemble the model of ``params`` (default: the embedded reference)."""
+def build_model(params: Parameters | None = None, mistuning=None) -> Model:
+    """Assemble the model of ``params`` (default: the embedded reference).
+
+    ``mistuning``: one stiffness deviation delta_j per blade (blade j's stiffness and stiffness-proportional
+    damping times 1 + delta_j, :func:`~rotorub_model.structure.blades.bladed_disk_matrices`); None: tuned."""
     p = params or reference_parameters()
     sh = shaft_matrices(p)
-    bd = bladed_disk_matrices(p)
+    bd = bladed_disk_matrices(p, mistuning=mistuning)
     cs = casing_matrices(p)
     ns = len(sh.dofs)
     nbt = len(bd.dofs) - ns
@@ -141,7 +145,7 @@ def build_model(params: Parameters | None = None) -> Model:
         ],
     )
     model = Model(params=p, dofs=dofs, f_unit=np.zeros(n), f_tangential=np.zeros(n), f_euler=np.zeros(n),
-                  slices=slices, **mats)
+                  slices=slices, mistuning=check_mistuning(p, mistuning), **mats)
     model.f_euler[slices["rotor"]] = bd.f_euler
     T, _ = model.disk_maps
     ang = np.radians(p.imbalance.angle_deg)
