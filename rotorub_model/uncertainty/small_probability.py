@@ -35,13 +35,18 @@ def run_small_probability(study: Study, evaluate: Callable[[np.ndarray], np.ndar
 
     ev = study.events[0]
     quantity, op, thr = ev.limit_state
+    # the limit state in display units (mm, N): the solvers' absolute tolerances (1e-5) then mean the same
+    # thing whatever the quantity (a margin of 1e-3 m met to 1e-5 m is 1 % off)
+    from .results import _scale
+
+    k = _scale(quantity)[0]
     d = study.dims
     n_calls = [0]
 
     def fsample(Z):
         Z = np.asarray(Z, dtype=float)
         n_calls[0] += len(Z)
-        y = evaluate(norm.cdf(Z))
+        y = k * evaluate(norm.cdf(Z))
         if not np.all(np.isfinite(y)):
             from ..errors import ConvergenceError
 
@@ -52,7 +57,7 @@ def run_small_probability(study: Study, evaluate: Callable[[np.ndarray], np.ndar
     f = ot.PythonFunction(d, 1, func_sample=fsample)
     f.setGradient(ot.CenteredFiniteDifferenceGradient(1e-4, f.getEvaluation()))
     Y = ot.CompositeRandomVector(f, ot.RandomVector(ot.Normal(d)))
-    event = ot.ThresholdEvent(Y, ot.Less() if op == "<" else ot.Greater(), thr)
+    event = ot.ThresholdEvent(Y, ot.Less() if op == "<" else ot.Greater(), k * thr)
     ot.RandomGenerator.SetSeed(int(study.seed))
     out: dict = {"event": ev.text, "limit_state": f"{quantity} {op} {thr:g}", "dims": d}
     if study.method == "form":
