@@ -148,8 +148,8 @@ def check_mistuning(p: Parameters, mistuning) -> tuple[float, ...] | None:
                              "deviation per blade (blades.count), or none (a tuned disk)")
     for j, v in enumerate(d):
         if not (np.isfinite(v) and v > -1.0):
-            raise ParameterError(f"mistuning[{j}]: {float(v)!r} out of range; accepted range (-1, inf) (blade {j + 1}'s "
-                                 "stiffness factor 1 + delta must stay positive)")
+            raise ParameterError(f"mistuning[{j}]: {float(v)!r} out of range; accepted range (-1, inf) "
+                                 f"(blade {j + 1}'s stiffness factor 1 + delta must stay positive)")
     return tuple(float(v) for v in d)
 
 

@@ -132,7 +132,8 @@ def test_form_is_exact_for_a_linear_limit_state_in_normal_inputs(c_closure, tmp_
 
 
 def test_subset_sampling_holds_a_small_probability_in_its_interval(c_closure):
-    pytest.importorskip("openturns", reason="subset sampling needs the uq extra's OpenTURNS (pip install 'rotorub[uq]')")
+    pytest.importorskip("openturns", reason="subset sampling needs the uq extra's OpenTURNS "
+                                            "(pip install 'rotorub[uq]')")
     mu, sd = 1.5e-3, 0.15e-3
     exact = norm.cdf((c_closure - mu) / sd)
     assert 1e-6 < exact < 1e-4
