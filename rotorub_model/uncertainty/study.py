@@ -361,7 +361,13 @@ def check_method(s: Study) -> None:
                 raise ParameterError(f"study.n: {total} points are too few for a {s.confidence:g} interval of the "
                                      f"{q:g} quantile (the order statistics bracket it from {need} points on); "
                                      "accepted: more points, or a less extreme quantile")
-    elif s.method == "sobol":
+    if s.method in ("sobol", "morris"):
+        try:
+            import SALib  # noqa: F401
+        except ImportError:
+            raise ParameterError(f"study.method: {s.method} runs on SALib, not installed; pip install "
+                                 "'rotorub[uq]'") from None
+    if s.method == "sobol":
         if not _is_pow2(s.n) or s.n < SOBOL_MIN_N:
             raise ParameterError(f"study.n: {s.n}; Sobol' indices take a base sample N that is a power of 2, at least "
                                  f"{SOBOL_MIN_N} (below, SALib's bootstrap intervals mean little), e.g. 1024")
