@@ -185,7 +185,8 @@ class UQResult:
                 ax.text(0.0, 0.02, " rub ←", ha="right", va="bottom", fontsize=8)
             ax.set_xlabel(f"{q} [{unit}]" if unit else q)
             ax.set_ylabel("cumulative probability")
-            ax.set_title(f"{q}: mean {est['mean'] * k:.4g} {unit}, sd {est['sd'] * k:.3g}", fontsize=9)
+            u = f" {unit}" if unit else ""
+            ax.set_title(f"{q}: mean {est['mean'] * k:.4g}{u}, sd {est['sd'] * k:.3g}{u}", fontsize=9)
             ax.grid(alpha=0.3)
             ax.legend(fontsize=7, loc="upper left")
         if probs:

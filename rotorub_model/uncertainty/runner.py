@@ -12,6 +12,7 @@ skips what is there and computes the rest, to the same numbers (tests/library/te
 from __future__ import annotations
 
 import math
+import os
 import time
 from pathlib import Path
 
@@ -83,6 +84,7 @@ class Evaluator:
         self.wall = 0.0
         self.seconds: dict[str, list[np.ndarray]] = {}
         self.chunk = 0
+        self.load = [_load()]
 
     def __call__(self, X: np.ndarray, D: np.ndarray | None, desc: str = "uq", progress: bool | None = None,
                  chunk: int | None = None) -> dict[str, np.ndarray]:
@@ -115,13 +117,22 @@ class Evaluator:
                           "ms_per_evaluation_median": float(np.median(s) * 1e3) if s.size else None,
                           "ms_per_evaluation_max": float(s.max() * 1e3) if s.size else None}
         busy = sum(v["seconds_total"] for v in levels.values())
+        self.load.append(_load())
         return {"levels": levels, "evaluations": self.points, "tasks": self.tasks, "evaluations_per_task": self.chunk,
                 "tasks_reused_from_store": self.reused, "wall_s": self.wall,
                 "evaluations_per_s": self.points / self.wall if self.wall > 0 else None,
                 "seconds_in_evaluations": busy,
                 "executor": _executor_name(self.executor),
+                "machine": {"cores": os.cpu_count(), "load_average_1min_start_end": [self.load[0], self.load[-1]]},
                 "note": "seconds per evaluation measured inside the workers (reused tasks: their first run's); "
                         "wall_s includes the executor's overhead and, on a resumed run, only the tasks computed"}
+
+
+def _load() -> float | None:
+    try:
+        return round(os.getloadavg()[0], 2)
+    except OSError:
+        return None
 
 
 def _executor_name(ex) -> str:
