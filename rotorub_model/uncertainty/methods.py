@@ -146,8 +146,8 @@ def estimate_probability(ind: np.ndarray, rep: np.ndarray, study: Study) -> dict
         lo, hi = min(lo, m - res), max(hi, m + res)
         if min(k, n - k) < FEW_EVENTS:
             lo, hi = proportion_interval(k, n, study.confidence, "exact")
-            how = (f"pooled Clopper-Pearson over the {n} points (the event at {min(k, n - k)} < {FEW_EVENTS} points: "
-                   "the replicate means are not normal)")
+            how = (f"pooled Clopper-Pearson over the {n} points (the event {'seen' if k <= n - k else 'missed'} at "
+                   f"{min(k, n - k)} < {FEW_EVENTS} points: the replicate means are not normal)")
         else:
             how = f"randomised QMC: Student t over {per.size} replicates"
         out.update(probability=m if min(k, n - k) >= FEW_EVENTS else k / n, low=max(lo, 0.0), high=min(hi, 1.0),

@@ -109,6 +109,7 @@ class Evaluator:
         return out
 
     def cost(self) -> dict:
+        """The per-evaluation cost table (seconds inside the workers by analysis, tasks, wall, load)."""
         levels = {}
         for lv, parts in self.seconds.items():
             s = np.concatenate(parts)
@@ -140,6 +141,10 @@ def _executor_name(ex) -> str:
         return "process pool (all cores)"
     if ex == "serial":
         return "serial"
+    from concurrent.futures import ProcessPoolExecutor
+
+    if isinstance(ex, ProcessPoolExecutor):
+        return f"process pool ({ex._max_workers} workers)"
     return type(ex).__name__
 
 
@@ -159,11 +164,21 @@ def run_uq(study: Study | str | Path, params=None, executor=None, out: str | Pat
     values: dict[str, np.ndarray] = {}
     rep = None
     if study.method in ("form", "subset"):
+        from ..analyses.sweeps import default_executor
         from .small_probability import run_small_probability
 
         qname = study.events[0].limit_state[0]
-        est["small_probability"] = run_small_probability(
-            study, lambda U: ev(*to_physical(study, U), desc=study.method, progress=False)[qname])
+        # FORM and subset sampling ask for many small batches: one pool for all of them (run_tasks would
+        # start and stop a pool, and its workers would build their model, for every batch)
+        own = executor is None
+        if own:
+            ev.executor = default_executor()
+        try:
+            est["small_probability"] = run_small_probability(
+                study, lambda U: ev(*to_physical(study, U), desc=study.method, progress=False)[qname])
+        finally:
+            if own:
+                ev.executor.shutdown()
     else:
         des = design(study)
         X, D = to_physical(study, des["U"])
