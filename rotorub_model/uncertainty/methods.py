@@ -267,7 +267,7 @@ def morris_indices(study: Study, G: np.ndarray, Y: np.ndarray) -> dict:
     prob = salib_problem(study)
     r = morris.analyze(prob, G, y, num_resamples=study.bootstrap, conf_level=study.confidence,
                        num_levels=study.levels, seed=study.seed, print_to_console=False)
-    return {"names": list(r["names"]), "mu": np.asarray(r["mu"]).tolist(), "mu_star": np.asarray(r["mu_star"]).tolist(),
-            "mu_star_conf": np.asarray(r["mu_star_conf"]).tolist(), "sigma": np.asarray(r["sigma"]).tolist(),
+    arr = {k: np.asarray(r[k], dtype=float).tolist() for k in ("mu", "mu_star", "mu_star_conf", "sigma")}
+    return {"names": [str(n) for n in r["names"]], **arr,  # sigma: NaN for a group (SALib)
             "interval": f"SALib bootstrap of mu* ({study.bootstrap} resamples), half-width at {study.confidence:g}",
             "scale": "elementary effects on the inputs' probability scale (unit cube), in the quantity's unit"}

@@ -26,6 +26,19 @@ def _scale(q: str) -> tuple[float, str]:
     return UNITS[QUANTITIES[q].unit]
 
 
+def _json_safe(x):
+    """Arrays to lists and NaN / inf to None: strict JSON (a Morris group's sigma is NaN in SALib)."""
+    if isinstance(x, dict):
+        return {k: _json_safe(v) for k, v in x.items()}
+    if isinstance(x, list | tuple):
+        return [_json_safe(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return _json_safe(x.tolist())
+    if isinstance(x, float | np.floating):
+        return float(x) if math.isfinite(x) else None
+    return x
+
+
 def _pct(p: float | None) -> str:
     if p is None or not math.isfinite(p):
         return "n/a"
@@ -138,11 +151,7 @@ class UQResult:
                {"from": self.speeds[0], "to": self.speeds[-1], "points": len(self.speeds)},
                "estimates": self.estimates, "cost": self.cost, "wall_s": self.wall_s,
                "build_clearance_for_p_rub_1pct_m": self.clearance_for(), "verdict": self.verdict()}
-        if "clearance_curve" in self.estimates:
-            cc = self.estimates["clearance_curve"]
-            out["estimates"] = {**self.estimates, "clearance_curve": {
-                k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in cc.items()}}
-        return out
+        return _json_safe(out)
 
     # ------------------------------------------------------------------ figures
     def figure(self, kind: str = "distributions"):
@@ -277,8 +286,13 @@ class UQResult:
                 ax.text(0.5, 0.5, mo["undefined"], ha="center", va="center", fontsize=8, transform=ax.transAxes)
                 continue
             k, unit = _scale(q)
-            ms, conf, sg = (np.asarray(mo[x]) * k for x in ("mu_star", "mu_star_conf", "sigma"))
-            ax.errorbar(ms, sg, xerr=conf, fmt="o", capsize=3)
+            ms, conf, sg = (np.asarray(mo[x], dtype=float) * k for x in ("mu_star", "mu_star_conf", "sigma"))
+            grp = ~np.isfinite(sg)  # a group (the mistuning pattern): SALib gives no sigma, drawn on the axis
+            sg = np.where(grp, 0.0, sg)
+            ax.errorbar(ms[~grp], sg[~grp], xerr=conf[~grp], fmt="o", capsize=3)
+            if grp.any():
+                ax.errorbar(ms[grp], sg[grp], xerr=conf[grp], fmt="s", mfc="none", capsize=3, color="C1",
+                            label="a group (σ not defined)")
             for i, nm in enumerate(mo["names"]):
                 ax.annotate(nm, (ms[i], sg[i]), textcoords="offset points", xytext=(4, 4), fontsize=8)
             top = max(float(np.max(ms + conf)), float(np.max(sg)), 1e-12)

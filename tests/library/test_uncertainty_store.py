@@ -32,7 +32,7 @@ seed = 4
 
 [operating]
 speed = 3.3
-t_end = 1.5
+t_end = 3.0   # long enough (~30 ms a task) that the poll below sees the run mid-way
 
 [inputs.g0]
 parameter = "contact.g0"
