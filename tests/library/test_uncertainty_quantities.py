@@ -20,9 +20,9 @@ SPEED = 3.3
 
 
 def spec(targets, quantities, speeds=(SPEED,), params=None, **kw):
-    return json.dumps({"model": "rotorub", "params": to_dict(params or reference_parameters()), "formulation": "3D",
-                       "speeds": list(speeds), "quantities": quantities, "targets": targets, "t_end": 1.5,
-                       "t_ramp": 1.0, **kw}, sort_keys=True)
+    d = {"model": "rotorub", "params": to_dict(params or reference_parameters()), "formulation": "3D",
+         "speeds": list(speeds), "quantities": quantities, "targets": targets, "t_end": 1.5, "t_ramp": 1.0}
+    return json.dumps({**d, **kw}, sort_keys=True)
 
 
 @pytest.fixture(scope="module")
@@ -101,3 +101,37 @@ def test_a_structural_input_rebuilds_the_model():
     c = closure(make_contact(m, "3D"), linear_responses(m, np.array([SPEED * 53.4])))[0]
     r = evaluate_chunk(spec(["bearings.front.k"], ["margin"]), [[k]])
     assert r["margin"][0] == pytest.approx(p.contact.g0 - c, abs=1e-15)
+
+
+def test_transient_with_a_casing_offset_runs_against_the_offset_liner(model):
+    from rotorub_model.contact.liner import Liner
+
+    g0, e = 0.335e-3, 0.1e-3
+    c = make_contact(model, "3D", g0=g0)
+    run = run_transient(model, c, SPEED * 53.4, t_end=1.5, t_ramp=1.0,
+                        liner=Liner.for_model(model, c, wears=False, offset=(e, 0.0)))
+    r = evaluate_chunk(spec(["contact.g0", "engine.offset"], ["peak_force"]), [[g0, e], [g0, 0.0]])
+    assert r["peak_force"][0] == run.outputs["F_N"].max()
+    assert r["peak_force"][0] > r["peak_force"][1]  # the offset casing presses one side harder
+
+
+def test_wear_depth_is_run_wears(model):
+    from rotorub_model.analyses.wear import run_wear
+
+    g0 = 0.335e-3
+    w = run_wear(model, "3D", SPEED, g0, t_end=1.5, t_ramp=1.0, yield_force=50.0)
+    p = reference_parameters().replace(abradable={"yield_force": 50.0})
+    r = evaluate_chunk(spec(["contact.g0"], ["wear_depth", "peak_force"], params=p), [[g0]])
+    assert w.summary()["depth_max_mm"] > 0
+    assert r["wear_depth"][0] * 1e3 == pytest.approx(w.summary()["depth_max_mm"], rel=1e-12)
+    assert r["peak_force"][0] == pytest.approx(float(w.transient.outputs["F_N"].max()), rel=1e-12)
+
+
+def test_diverged_is_the_section_6_verdict():
+    """At the section-6 point the 2D static solution is unstable and its 8 s run diverges; the 3D one settles.
+    A run under 4 s that stays within the liner gets no verdict (NaN), as app/studies.py says."""
+    s2 = spec(["contact.g0"], ["diverged"], formulation="2D", t_end=8.0)
+    s3 = spec(["contact.g0"], ["diverged"], t_end=8.0)
+    assert evaluate_chunk(s2, [[0.335e-3]])["diverged"][0] == 1.0
+    assert evaluate_chunk(s3, [[0.335e-3]])["diverged"][0] == 0.0
+    assert np.isnan(evaluate_chunk(spec(["contact.g0"], ["diverged"], t_end=2.0), [[0.335e-3]])["diverged"][0])

@@ -124,3 +124,19 @@ def test_cli_bad_study_exit_2_one_line_nothing_written(tmp_path, capsys):
     assert main(["uq", str(f), "--out", str(out)]) == 2
     assert "not valid TOML" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_parameter_file_next_to_the_study_and_the_cli_override(tmp_path):
+    from rotorub_model.structure.params import reference_parameters, to_toml
+
+    (tmp_path / "engine.toml").write_text(to_toml(reference_parameters().replace(contact={"mu": 0.3})))
+    (tmp_path / "other.toml").write_text(to_toml(reference_parameters().replace(contact={"mu": 0.2})))
+    f = tmp_path / "study.toml"
+    f.write_text('[study]\nparams = "engine.toml"\nn = 16\nreplicates = 2\nquantiles = [0.5]\n'
+                 '[operating]\nspeed = 3.3\n[inputs.g0]\nparameter = "contact.g0"\ndistribution = "uniform"\n'
+                 'low = 0.5e-3\nhigh = 1e-3\n')
+    assert load_study(f).params.contact.mu == 0.3
+    assert load_study(f, params=tmp_path / "other.toml").params.contact.mu == 0.2
+    (tmp_path / "engine.toml").unlink()
+    with pytest.raises(ParameterError, match=r"engine.toml': cannot be read"):
+        load_study(f)
