@@ -351,7 +351,8 @@ class UQResult:
         else:
             per = sp["probability_per_step"]
             ax.semilogy(range(1, len(per) + 1), per, "o-")
-            ax.set_xlabel("subset step")
+            ax.set_xticks(range(1, len(per) + 1))
+            ax.set_xlabel("subset step (each a conditional probability of about 0.1)")
             ax.set_ylabel("probability estimate after the step")
             ax.set_title(f"P({sp['event']}) = {sp['probability']:.3e} [{sp['low']:.2e}, {sp['high']:.2e}] (subset "
                          f"sampling, {sp['evaluations']} evaluations)", fontsize=9)
