@@ -185,13 +185,16 @@ class RotorubContext:
         return smp.me * (math.cos(d) * Q[:, 0] + math.sin(d) * Q[:, 1])
 
     def basis_for(self, smp: Sample, tuned: bool = False):
-        key = (smp.rebuild, tuple(sorted((k, v) for k, v in smp.contact.items() if k in CONTACT_GEOMETRY)),
-               None if tuned or smp.delta is None else tuple(smp.delta))
+        mistuned = not tuned and smp.delta is not None
+        if mistuned:  # every mistuned sample is a disk of its own: nothing to keep
+            m = self.structure(smp)
+            return self.basis(m, self.contact(m, smp, 0.0))
+        key = (smp.rebuild, tuple(sorted((k, v) for k, v in smp.contact.items() if k in CONTACT_GEOMETRY)))
         b = self._bases.get(key)
         if b is None:
             m = self.structure(smp, tuned)
             b = self.basis(m, self.contact(m, smp, 0.0))
-            if len(self._bases) > 256:
+            if len(self._bases) > 64:
                 self._bases.clear()
             self._bases[key] = b
         return b

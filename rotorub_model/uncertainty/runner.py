@@ -173,12 +173,25 @@ def run_uq(study: Study | str | Path, params=None, executor=None, out: str | Pat
         own = executor is None
         if own:
             ev.executor = default_executor()
+        bar = None
+        if progress:  # the algorithm decides how many evaluations it needs: a bar that counts them
+            from tqdm import tqdm
+
+            bar = tqdm(desc=f"uq {study.method}", unit="evaluation")
+
+        def limit_state(U):
+            y = ev(*to_physical(study, U), desc=study.method, progress=False)[qname]
+            if bar is not None:
+                bar.update(len(U))
+            return y
+
         try:
-            est["small_probability"] = run_small_probability(
-                study, lambda U: ev(*to_physical(study, U), desc=study.method, progress=False)[qname])
+            est["small_probability"] = run_small_probability(study, limit_state)
         finally:
             if own:
                 ev.executor.shutdown()
+            if bar is not None:
+                bar.close()
     else:
         des = design(study)
         X, D = to_physical(study, des["U"])
