@@ -96,14 +96,17 @@ def main(argv: list[str] | None = None) -> int:
     per = cost["levels"]["transient"]["ms_per_evaluation_mean"]
     print(f"  serial                      {base:6.2f} s   ({per:.1f} ms per transient inside)")
     for kind in kinds:
-        times = {}
+        times, load = {}, {}
         for workers in (1, 2):
             ex, own = make_executor(kind, workers)
             warm(ex)
             times[workers], _ = timed(st, ex)
+            load[workers] = os.getloadavg()[0]
             _close(ex, own)
+        # the 1-minute load average includes this run's own workers (1 or 2): above that, others ran too
         print(f"  {kind:27s} 1 worker {times[1]:6.2f} s, 2 workers {times[2]:6.2f} s: speed-up "
-              f"{times[1] / times[2]:.2f}x (1 worker / serial {times[1] / base:.2f})")
+              f"{times[1] / times[2]:.2f}x (1 worker / serial {times[1] / base:.2f}; load after each "
+              f"{load[1]:.1f}, {load[2]:.1f})")
     print(f"\nload average {os.getloadavg()[0]:.2f} at the end (2 cores: above 2, the workers share them with others)")
     return 0
 
