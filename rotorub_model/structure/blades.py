@@ -39,6 +39,7 @@ requested ratio on the first bending mode at rest.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from functools import lru_cache
 
 import numpy as np
@@ -135,7 +136,7 @@ def skew(v: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
-def check_mistuning(p: Parameters, mistuning) -> tuple[float, ...] | None:
+def check_mistuning(p: Parameters, mistuning: Sequence[float] | np.ndarray | None) -> tuple[float, ...] | None:
     """The per-blade stiffness deviations delta_j as a tuple (None, or empty: a tuned disk), checked: one finite
     value per blade, each > -1 (the blade's stiffness factor 1 + delta_j stays positive)."""
     if mistuning is None or len(mistuning) == 0:
@@ -153,7 +154,8 @@ def check_mistuning(p: Parameters, mistuning) -> tuple[float, ...] | None:
     return tuple(float(v) for v in d)
 
 
-def bladed_disk_matrices(p: Parameters, n_quad: int | None = None, mistuning=None) -> Matrices:
+def bladed_disk_matrices(p: Parameters, n_quad: int | None = None,
+                         mistuning: Sequence[float] | np.ndarray | None = None) -> Matrices:
     """Matrices of the blades on the dofs [shaft dofs, blade dofs] (coupled through the disk).
 
     ``mistuning``: per-blade stiffness deviations delta_j (one per blade; None or empty: tuned). Blade j's

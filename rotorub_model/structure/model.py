@@ -16,6 +16,7 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -116,7 +117,7 @@ def _place(n: int, parts: list[tuple[Matrices, np.ndarray]]) -> dict[str, np.nda
     return out
 
 
-def build_model(params: Parameters | None = None, mistuning=None) -> Model:
+def build_model(params: Parameters | None = None, mistuning: Sequence[float] | np.ndarray | None = None) -> Model:
     """Assemble the model of ``params`` (default: the embedded reference).
 
     ``mistuning``: one stiffness deviation delta_j per blade (blade j's stiffness and stiffness-proportional

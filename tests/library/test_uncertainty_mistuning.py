@@ -108,3 +108,25 @@ def test_blade_tip_deflection_is_the_blade_functions_at_the_tip(tuned):
     r = blade_tip_deflections(tuned, q)
     assert r[2] == pytest.approx(1e-3)  # the kept functions are scaled to a unit tip deflection (blades.py)
     assert np.count_nonzero(r) == 1
+
+
+def test_stability_map_of_a_mistuned_disk_is_that_disks(tuned):
+    """The maps' workers rebuild the model from its parameters: a mistuned model's deviations travel with the
+    rows (analyses/maps.py), so its map is its own, cell by cell, and not the tuned disk's."""
+    from rotorub_model.analyses.maps import run_stability_map
+    from rotorub_model.analyses.stability import stability_indicators
+    from rotorub_model.analyses.static import solve_static
+    from rotorub_model.contact import make_contact
+
+    m = build_model(mistuning=3 * DELTA)
+    speeds, g0s = np.array([3.3]), np.array([0.2e-3, 0.335e-3])
+    mp = run_stability_map(m, "3D", speeds, g0s, executor="serial", progress=False)
+    tp = run_stability_map(tuned, "3D", speeds, g0s, executor="serial", progress=False)
+    w = 3.3 * 53.4
+    q = None
+    for j in (1, 0):  # the map continues from the largest clearance down
+        c = make_contact(m, "3D", g0=float(g0s[j]))
+        st = solve_static(m, c, w, q0=q)
+        q = st.q
+        assert mp.max_real[0, j] == stability_indicators(m, c, w, st.q)[0]
+    assert not np.array_equal(mp.max_real, tp.max_real)
