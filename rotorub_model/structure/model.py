@@ -175,7 +175,8 @@ def save_model(model: Model, path: str | Path) -> Path:
     path = Path(path)
     np.savez(path, params=json.dumps(to_dict(model.params)), dofs=np.array(model.dofs),
              slices=json.dumps({k: [s.start, s.stop] for k, s in model.slices.items()}),
-             disk_T=T, disk_R=R, **{k: getattr(model, k) for k in _ARRAYS})
+             disk_T=T, disk_R=R, **{k: getattr(model, k) for k in _ARRAYS},
+             **({} if model.mistuning is None else {"mistuning": np.array(model.mistuning)}))
     return path
 
 
@@ -190,6 +191,7 @@ def load_model(path: str | Path, params: Parameters | None = None) -> Model:
             raise ValueError("load_model: the parameters differ from the saved model's outside [contact]")
         m = Model(params=params or saved, dofs=[str(x) for x in d["dofs"]],
                   slices={k: slice(a, b) for k, (a, b) in json.loads(str(d["slices"])).items()},
+                  mistuning=tuple(float(v) for v in d["mistuning"]) if "mistuning" in d.files else None,
                   **{k: np.array(d[k]) for k in _ARRAYS})
         m.__dict__["disk_maps"] = (np.array(d["disk_T"]), np.array(d["disk_R"]))
     return m

@@ -130,3 +130,11 @@ def test_stability_map_of_a_mistuned_disk_is_that_disks(tuned):
         q = st.q
         assert mp.max_real[0, j] == stability_indicators(m, c, w, st.q)[0]
     assert not np.array_equal(mp.max_real, tp.max_real)
+
+
+def test_saved_mistuned_model_keeps_its_deviations(tmp_path):
+    from rotorub_model.structure.model import load_model, save_model
+
+    m = load_model(save_model(build_model(mistuning=DELTA), tmp_path / "m.npz"))
+    assert m.mistuning == tuple(DELTA)
+    assert load_model(save_model(build_model(), tmp_path / "t.npz")).mistuning is None
