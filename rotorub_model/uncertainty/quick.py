@@ -51,7 +51,8 @@ def quick_studies(model: Model) -> dict:
 
 def run_uq_quick(model: Model, out: str | Path, executor=None, progress: bool = False) -> tuple[dict, str]:
     """Both quick studies on ``model``'s parameters, saved in out/tolerances and out/mistuning; returns
-    ({name: UQResult}, the markdown section)."""
+    ({name: UQResult}, the markdown section). A configuration without imbalance, or without a critical speed
+    within its validity, gets the rub studies' one-line :class:`ParameterError`."""
     from ..errors import ParameterError
 
     if model.params.imbalance.me == 0.0:
