@@ -245,8 +245,8 @@ class RotorubContext:
                     if "rub" in want:
                         out["rub"][i] = float(mg < 0.0)
                 if "amp_linear" in want:
-                    r = blade_tip_deflections(self.model0, self.linear_q(smp, b)).max()
-                    r0 = blade_tip_deflections(self.model0, self.linear_q(smp, self.basis_for(smp, True))).max()
+                    r = self.tips(smp, self.linear_q(smp, b)).max()
+                    r0 = self.tips(smp, self.linear_q(smp, self.basis_for(smp, True))).max()
                     out["amp_linear"][i] = r / r0 if r0 > 0 else math.nan
                 secs["detection"][i] = time.perf_counter() - t
             if "static" in self.levels:
@@ -264,10 +264,10 @@ class RotorubContext:
                     if want & {"amp_contact", "amp_force"}:
                         st0, _ = self._cached_tuned("static", smp, lambda s=smp: self.static(s, tuned=True))
                         if st0.converged:
-                            r0 = blade_tip_deflections(self.model0, st0.q).max()
+                            r0 = self.tips(smp, st0.q).max()
                             f0 = float(st0.forces_N.max())
                             if "amp_contact" in want and r0 > 0:
-                                out["amp_contact"][i] = blade_tip_deflections(self.model0, st.q).max() / r0
+                                out["amp_contact"][i] = self.tips(smp, st.q).max() / r0
                             if "amp_force" in want and f0 > 0:
                                 out["amp_force"][i] = float(st.forces_N.max()) / f0
                 secs["static"][i] = time.perf_counter() - t
@@ -278,6 +278,10 @@ class RotorubContext:
         for lv, v in secs.items():
             out[f"seconds_{lv}"] = v
         return out
+
+    def tips(self, smp: Sample, Q: np.ndarray) -> np.ndarray:
+        """Blade tip deflections of states Q with the sample's blades (a structural input may change them)."""
+        return blade_tip_deflections(self.structure(smp, tuned=True), Q)
 
     def _cached_tuned(self, what: str, smp: Sample, make):
         key = (what, smp.key(with_mistuning=False))
@@ -306,7 +310,7 @@ class RotorubContext:
         if "amp_contact_transient" in want:
             def peak(r):
                 after = r.t >= self.t_ramp
-                return blade_tip_deflections(self.model0, r.q[after]).max() if after.any() else math.nan
+                return self.tips(smp, r.q[after]).max() if after.any() else math.nan
 
             r0 = self._cached_tuned("transient", smp,
                                     lambda: peak(self.transient(smp, tuned=True, wear=wear)[0]))

@@ -77,8 +77,7 @@ class MistuningSpec:
             nums[k] = float(v)
         spec = cls(kind, nums["sd"], dist, nums["truncate"], nums["correlation"], int(n_blades))
         lo, hi = spec.marginal.support()
-        floor = -1.0 if kind == "stiffness" else -1.0  # delta > -1; for a frequency, eps > -1 likewise
-        if not lo > floor:
+        if not lo > -1.0:  # delta > -1 (a positive stiffness); for a frequency, eps > -1 likewise
             raise ParameterError(f"{where}.distribution: {dist} has support [{lo:g}, {hi:g}] which leaves the accepted "
                                  f"range of a blade's relative {kind} deviation, (-1, inf); use truncnormal "
                                  "(truncated at 'truncate' standard deviations) or uniform")
