@@ -120,7 +120,12 @@ class Study:
             n = min(self.n, max(MORRIS_MIN_TRAJECTORIES, self.n // 4))
         elif self.method == "subset":
             n = min(self.n, max(500, self.n // 4))
-        return dataclasses.replace(self, n=n)
+        q = dataclasses.replace(self, n=n)
+        try:
+            check_method(q)  # the smaller sample must still carry the intervals asked for
+        except ParameterError as exc:
+            raise ParameterError(f"--quick: {exc}") from None
+        return q
 
     def summary(self) -> dict:
         return {
