@@ -154,16 +154,17 @@ class ContactSetStarts:
 
 
 @lru_cache(maxsize=8)
-def _cached_model(params_json: str) -> Model:
+def _cached_model(params_json: str, mistuning: tuple[float, ...] | None = None) -> Model:
     import json
 
-    return build_model(from_dict(json.loads(params_json)))
+    return build_model(from_dict(json.loads(params_json)), mistuning=mistuning)
 
 
 def map_row(params_json: str, formulation: str, variant: str, speed: float, g0s: list[float],
-            solver: str = ROW_SOLVER) -> dict[str, np.ndarray]:
-    """One speed row of a static/stability map (top-level: runs in any worker)."""
-    model = _cached_model(params_json)
+            solver: str = ROW_SOLVER, mistuning: list[float] | None = None) -> dict[str, np.ndarray]:
+    """One speed row of a static/stability map (top-level: runs in any worker); ``mistuning``: the model's
+    per-blade stiffness deviations (the parameters do not hold them)."""
+    model = _cached_model(params_json, None if mistuning is None else tuple(mistuning))
     omega = speed * model.params.normalisation.omega_ref
     order = np.argsort(g0s)[::-1]
     n = len(g0s)
@@ -347,6 +348,9 @@ def run_stability_map(
          "solver": ROW_SOLVER}
         for s in speeds
     ]
+    if model.mistuning is not None:  # the workers rebuild the model: a mistuned disk's deviations go with it
+        for pl in payloads:
+            pl["mistuning"] = list(model.mistuning)
     rows = run_tasks(map_row, payloads, executor=executor, out=out, progress=progress,
                      desc=f"{formulation} static+stability map")
     stack = {k: np.array([r[k] for r in rows]) for k in rows[0]}

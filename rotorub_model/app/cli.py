@@ -326,6 +326,19 @@ def cmd_forced_response(ns: argparse.Namespace) -> dict:
                                executor="serial" if ns.executor == "serial" else None)
 
 
+@command("uq", "will it rub? an uncertainty study from a study file (TOML): rub probability with its interval, "
+         "Sobol'/Morris indices, small probabilities (FORM, subset), mistuned disks")
+@arg("study", help="the study file (rotorub_model/data/study_example.toml is a commented example)")
+@arg("--executor", default="process", choices=["process", "serial", "dask"],
+     help="process pool on all cores, serial, or a Dask cluster")
+@arg("--dask-address", default=None, help="scheduler address (default: a local Dask cluster)")
+@arg("--quick", action="store_true", help="an eighth of the study's points (a quarter for morris, subset)")
+def cmd_uq(ns: argparse.Namespace) -> dict:
+    from ..uncertainty.cli import run_uq_command
+
+    return run_uq_command(ns, lambda: _executor(ns))
+
+
 @command("reproduce", "main job: every analysis of the paper on one configuration, with a summary")
 @arg("--quick", action="store_true", help="coarse grids: a few minutes on 2 cores")
 @arg("--no-fmu", action="store_true", help="library analyses only (no FMU build, harnesses or coupled run)")

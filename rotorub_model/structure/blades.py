@@ -39,6 +39,7 @@ requested ratio on the first bending mode at rest.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from functools import lru_cache
 
 import numpy as np
@@ -135,9 +136,34 @@ def skew(v: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
-def bladed_disk_matrices(p: Parameters, n_quad: int | None = None) -> Matrices:
-    """Matrices of the blades on the dofs [shaft dofs, blade dofs] (coupled through the disk)."""
+def check_mistuning(p: Parameters, mistuning: Sequence[float] | np.ndarray | None) -> tuple[float, ...] | None:
+    """The per-blade stiffness deviations delta_j as a tuple (None, or empty: a tuned disk), checked: one finite
+    value per blade, each > -1 (the blade's stiffness factor 1 + delta_j stays positive)."""
+    if mistuning is None or len(mistuning) == 0:
+        return None
+    from ..errors import ParameterError
+
+    d = np.asarray(mistuning, dtype=float).ravel()
+    if d.size != p.blades.count:
+        raise ParameterError(f"mistuning: {d.size} values for {p.blades.count} blades; accepted: one stiffness "
+                             "deviation per blade (blades.count), or none (a tuned disk)")
+    for j, v in enumerate(d):
+        if not (np.isfinite(v) and v > -1.0):
+            raise ParameterError(f"mistuning[{j}]: {float(v)!r} out of range; accepted range (-1, inf) "
+                                 f"(blade {j + 1}'s stiffness factor 1 + delta must stay positive)")
+    return tuple(float(v) for v in d)
+
+
+def bladed_disk_matrices(p: Parameters, n_quad: int | None = None,
+                         mistuning: Sequence[float] | np.ndarray | None = None) -> Matrices:
+    """Matrices of the blades on the dofs [shaft dofs, blade dofs] (coupled through the disk).
+
+    ``mistuning``: per-blade stiffness deviations delta_j (one per blade; None or empty: tuned). Blade j's
+    bending stiffness K_b and its stiffness-proportional damping D_b are scaled by (1 + delta_j): its
+    frequencies at rest by sqrt(1 + delta_j), its damping ratio likewise; mass, centrifugal stiffening and the
+    disk coupling are the tuned blade's (docs/THEORY.md section 10)."""
     b = p.blades
+    scale = check_mistuning(p, mistuning)
     ns = 2 * p.shaft.n_ritz
     nb = b.dofs
     N = b.count
@@ -166,8 +192,8 @@ def bladed_disk_matrices(p: Parameters, n_quad: int | None = None) -> Matrices:
     for j, alpha in enumerate(blade_angles(p)):
         e_r, e_t, _, nv = blade_frame(alpha, beta)
         sl = slice(ns + j * nb, ns + (j + 1) * nb)
-        K[sl, sl] += Kb
-        D[sl, sl] += Db
+        K[sl, sl] += Kb if scale is None else (1.0 + scale[j]) * Kb
+        D[sl, sl] += Db if scale is None else (1.0 + scale[j]) * Db
         for g in range(s.size):
             R = b.hub_radius + s[g]
             rho0 = R * e_r

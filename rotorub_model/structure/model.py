@@ -16,6 +16,7 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -23,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import kernel
-from .blades import bladed_disk_matrices
+from .blades import bladed_disk_matrices, check_mistuning
 from .casing import casing_matrices
 from .frames import MATRIX_KEYS, Matrices
 from .params import Parameters, from_dict, reference_parameters, to_dict
@@ -51,6 +52,7 @@ class Model:
     f_tangential: np.ndarray  # imbalance force for m e = 1 kg m at dOmega/dt = 1 rad/s^2
     f_euler: np.ndarray  # inertia load of the blades at dOmega/dt = 1 rad/s^2
     slices: dict[str, slice]
+    mistuning: tuple[float, ...] | None = None  # per-blade stiffness deviations (build_model); None: tuned
 
     @property
     def n_dofs(self) -> int:
@@ -117,11 +119,14 @@ def _place(n: int, parts: list[tuple[Matrices, np.ndarray]]) -> dict[str, np.nda
     return out
 
 
-def build_model(params: Parameters | None = None) -> Model:
-    """Assemble the model of ``params`` (default: the embedded reference)."""
+def build_model(params: Parameters | None = None, mistuning: Sequence[float] | np.ndarray | None = None) -> Model:
+    """Assemble the model of ``params`` (default: the embedded reference).
+
+    ``mistuning``: one stiffness deviation delta_j per blade (blade j's stiffness and stiffness-proportional
+    damping times 1 + delta_j, :func:`~rotorub_model.structure.blades.bladed_disk_matrices`); None: tuned."""
     p = params or reference_parameters()
     sh = shaft_matrices(p)
-    bd = bladed_disk_matrices(p)
+    bd = bladed_disk_matrices(p, mistuning=mistuning)
     cs = casing_matrices(p)
     ns = len(sh.dofs)
     nbt = len(bd.dofs) - ns
@@ -143,7 +148,7 @@ def build_model(params: Parameters | None = None) -> Model:
         ],
     )
     model = Model(params=p, dofs=dofs, f_unit=np.zeros(n), f_tangential=np.zeros(n), f_euler=np.zeros(n),
-                  slices=slices, **mats)
+                  slices=slices, mistuning=check_mistuning(p, mistuning), **mats)
     model.f_euler[slices["rotor"]] = bd.f_euler
     T, _ = model.disk_maps
     ang = np.radians(p.imbalance.angle_deg)
@@ -172,7 +177,8 @@ def save_model(model: Model, path: str | Path) -> Path:
     path = Path(path)
     np.savez(path, params=json.dumps(to_dict(model.params)), dofs=np.array(model.dofs),
              slices=json.dumps({k: [s.start, s.stop] for k, s in model.slices.items()}),
-             disk_T=T, disk_R=R, **{k: getattr(model, k) for k in _ARRAYS})
+             disk_T=T, disk_R=R, **{k: getattr(model, k) for k in _ARRAYS},
+             **({} if model.mistuning is None else {"mistuning": np.array(model.mistuning)}))
     return path
 
 
@@ -187,6 +193,7 @@ def load_model(path: str | Path, params: Parameters | None = None) -> Model:
             raise ValueError("load_model: the parameters differ from the saved model's outside [contact]")
         m = Model(params=params or saved, dofs=[str(x) for x in d["dofs"]],
                   slices={k: slice(a, b) for k, (a, b) in json.loads(str(d["slices"])).items()},
+                  mistuning=tuple(float(v) for v in d["mistuning"]) if "mistuning" in d.files else None,
                   **{k: np.array(d[k]) for k in _ARRAYS})
         m.__dict__["disk_maps"] = (np.array(d["disk_T"]), np.array(d["disk_R"]))
     return m
