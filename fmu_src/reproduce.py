@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from rotorub_model.results import write_json
+from rotorub_model.writing import write_json
 
 
 def _step(msg: str) -> None:

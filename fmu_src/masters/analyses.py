@@ -26,7 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rotorub_model.results import pyplot, save_figure, write_json
+from rotorub_model.plotting import pyplot, save_figure
+from rotorub_model.writing import write_json
 
 from .fmi2 import Slave
 
@@ -277,7 +278,7 @@ def _rel_diff(a: np.ndarray, b: np.ndarray) -> float:
 
 def _plot_forces(runs: dict[str, FMURun], path: Path, title: str, diverged: dict[str, bool]) -> Path:
     """One panel per formulation; a blade keeps its colour in every panel, legends right of the data."""
-    from rotorub_model.results import legend_outside, plot_blade_forces
+    from rotorub_model.plotting import legend_outside, plot_blade_forces
 
     plt = pyplot()
     fig, axes = plt.subplots(len(runs), 1, figsize=(9, 3 * len(runs)), sharex=True, squeeze=False)
@@ -363,7 +364,7 @@ def run_up(fmu: str | Path, model, out: str | Path, speed_from: float = 2.6, spe
     lib = run_transient(model, make_contact(model, formulation, g0=g0), omega_of_t, t_end=duration, t_ramp=0.0,
                         me=me, record_dt=h, hold=h)
 
-    from rotorub_model.results import legend_outside, plot_blade_forces
+    from rotorub_model.plotting import legend_outside, plot_blade_forces
 
     plt = pyplot()
     fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)

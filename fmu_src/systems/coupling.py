@@ -54,7 +54,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rotorub_model.results import pyplot, save_figure, write_json
+from rotorub_model.plotting import pyplot, save_figure
+from rotorub_model.writing import write_json
 
 from ..masters.fmi2 import FMUError, Slave
 from ..models.contact.builder import build_native_fmu

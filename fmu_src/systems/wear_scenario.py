@@ -24,7 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rotorub_model.results import pyplot, save_figure, write_json
+from rotorub_model.plotting import pyplot, save_figure
+from rotorub_model.writing import write_json
 
 from ..models.clearance.builder import build_clearance_fmu
 from ..models.contact.builder import build_native_fmu

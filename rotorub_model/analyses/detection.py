@@ -45,8 +45,9 @@ import numpy as np
 
 from ..contact import ContactModel, make_contact
 from ..errors import ParameterError
-from ..results import pyplot, save_figure, write_json
+from ..plotting import pyplot, save_figure
 from ..structure.model import Model
+from ..writing import write_json
 from .linear import _check_speed_range, run_response
 
 THETAS_DEG = (0.0, 5.0, 10.0, 20.0, 30.0)

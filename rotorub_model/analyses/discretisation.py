@@ -24,9 +24,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..results import pyplot, save_figure, save_result
+from ..plotting import pyplot, save_figure
 from ..structure.blades import bladed_disk_matrices
 from ..structure.params import Parameters
+from ..writing import save_result
 
 N_CONVERGED = 8  # functions of the converged reference (flap and lag agree with 10 to 1e-5)
 
@@ -152,7 +153,7 @@ class BladeConvergence:
     def plot(self, path: str | Path) -> Path:
         """Error against n: one colour per number of functions in both panels (flap solid, lag dashed; the
         reduced bases in their n_ritz's colour, a line style and marker per n_modes), legends outside."""
-        from ..results import legend_outside
+        from ..plotting import legend_outside
 
         plt = pyplot()
         fig, axes = plt.subplots(1, 2, figsize=(12, 4.4))

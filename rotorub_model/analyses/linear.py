@@ -29,8 +29,9 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
-from ..results import pyplot, save_figure, save_result
+from ..plotting import pyplot, save_figure
 from ..structure.model import Model
+from ..writing import save_result
 
 
 def linear_response(model: Model, omega: float, me: float | None = None) -> np.ndarray:

@@ -39,9 +39,10 @@ from pathlib import Path
 import numpy as np
 
 from ..contact import ContactModel, make_contact
-from ..results import pyplot, save_figure, save_result
+from ..plotting import pyplot, save_figure
 from ..structure.model import Model, build_model
 from ..structure.params import from_dict, to_dict
+from ..writing import save_result
 from .stability import stability_indicators
 from .static import StaticResult, solve_static
 from .sweeps import run_tasks

@@ -43,8 +43,9 @@ from .. import kernel
 from ..contact import ContactModel
 from ..contact.liner import Liner
 from ..errors import ParameterError
-from ..results import pyplot, save_figure, save_result
+from ..plotting import pyplot, save_figure
 from ..structure.model import Model
+from ..writing import save_result
 
 
 def all_closed_stiffness(contact: ContactModel, omega: float) -> np.ndarray:
@@ -383,7 +384,7 @@ class TransientResult:
         }
 
     def plot(self, path: str | Path, title: str = "") -> Path:
-        from ..results import legend_outside, plot_blade_forces
+        from ..plotting import legend_outside, plot_blade_forces
 
         plt = pyplot()
         fig, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)

@@ -22,8 +22,9 @@ import numpy as np
 from ..contact import make_contact
 from ..contact.liner import Liner
 from ..errors import ParameterError
-from ..results import legend_outside, plot_blade_forces, pyplot, save_figure, write_json
+from ..plotting import legend_outside, plot_blade_forces, pyplot, save_figure
 from ..structure.model import Model
+from ..writing import write_json
 from .transient import TransientResult, run_transient
 
 

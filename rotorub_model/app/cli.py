@@ -180,7 +180,7 @@ def cmd_static(ns: argparse.Namespace) -> dict:
     from ..analyses.stability import stability_of
     from ..analyses.static import solve_static
     from ..contact import make_contact
-    from ..results import write_json
+    from ..writing import write_json
 
     m = _model(ns)
     c = make_contact(m, ns.formulation, g0=ns.g0)
@@ -198,7 +198,7 @@ def cmd_static(ns: argparse.Namespace) -> dict:
 
 
 def _plot_static(contact, st, path: Path, title: str) -> None:
-    from ..results import pyplot, save_figure
+    from ..plotting import pyplot, save_figure
 
     plt = pyplot()
     g = contact.gaps(st.q) * 1e3
@@ -358,7 +358,7 @@ def cmd_reproduce(ns: argparse.Namespace) -> dict:
                                  "pip install -e '.[fmu]', or run with --no-fmu") from None
         part = run_fmu_part(model, ns.out, s, quick=ns.quick, fmu_dir=ns.fmu_dir, params_file=ns.params)
         s.update(part["summary"])
-        from ..results import write_json
+        from ..writing import write_json
         from .report import write_report
 
         write_json(Path(ns.out) / "summary.json", s)
@@ -431,7 +431,7 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"rotorub {ns.command}: interrupted", file=sys.stderr)
         return 130
-    from ..results import plain
+    from ..writing import plain
 
     text = json.dumps(plain(result), indent=1) if isinstance(result, dict) else str(result)
     print(text if len(text) < 4000 else text[:4000] + "\n... (full result in --out)")

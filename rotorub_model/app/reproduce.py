@@ -11,8 +11,8 @@ import hashlib
 import json
 from pathlib import Path
 
-from ..results import write_json
 from ..structure.model import Model
+from ..writing import write_json
 
 
 def fact1(resp: dict) -> dict:

@@ -17,8 +17,9 @@ from ..analyses.static import solve_static
 from ..analyses.transient import TransientResult, run_transient
 from ..contact import make_contact
 from ..errors import ParameterError
-from ..results import pyplot, save_figure, write_json
+from ..plotting import pyplot, save_figure
 from ..structure.model import Model
+from ..writing import write_json
 
 PAPER_POINT = (3.3, 0.8e-3)  # the paper's transient point (normalised speed, g0 [m])
 PAPER_PARTIAL = 0.88  # the paper's third blade touches over 88 % of its chord at that point
@@ -352,7 +353,7 @@ class TransientStudy:
     def plot(self, path: str | Path) -> Path:
         """2D and 3D forces side by side (each on its own scale: a diverging 2D run would flatten the 3D one);
         a blade keeps its colour in both panels and the one legend sits right of them, outside the data."""
-        from ..results import plot_blade_forces
+        from ..plotting import plot_blade_forces
 
         plt = pyplot()
         fig, axes = plt.subplots(1, 2, figsize=(12, 4.2))

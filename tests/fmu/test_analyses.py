@@ -70,7 +70,7 @@ def test_quasi_static_map_hatches_unstable_cells_cell_by_cell(monkeypatch, tmp_p
     legend entry, and the legend sits below the axes."""
     from matplotlib.patches import Rectangle
 
-    from rotorub_model.results import pyplot
+    from rotorub_model.plotting import pyplot
 
     speeds, g0s = np.linspace(3.0, 3.8, 5), np.array([0.0, 0.5e-3, 1e-3, 2e-3])
     n = np.array([[3, 2, 0, 0], [4, 3, 1, 0], [5, 3, 2, 0], [5, 4, -1, 0], [4, 2, 0, 0]])

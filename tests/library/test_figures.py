@@ -17,7 +17,7 @@ from rotorub_model.analyses.transient import run_transient
 from rotorub_model.app import studies
 from rotorub_model.app.studies import default_grid
 from rotorub_model.contact import make_contact
-from rotorub_model.results import pyplot
+from rotorub_model.plotting import pyplot
 from rotorub_model.structure.model import build_model
 from rotorub_model.structure.params import reference_parameters
 

@@ -27,8 +27,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ...results import pyplot, save_figure, write_json
+from ...plotting import pyplot, save_figure
 from ...structure.model import Model
+from ...writing import write_json
 from ..maps import StabilityMap
 from ..transient import run_transient
 from .boundary import Curve, nearest_on_polyline, trace_boundaries
