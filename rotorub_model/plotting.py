@@ -22,7 +22,7 @@ def save_figure(fig, path: str | Path, dpi: int = 120, layout: bool = True) -> P
     """Lay out (unless the caller did: ``layout=False``), write the PNG and release the figure (figures
     are many in a sweep: never leak one). The saved area grows to take in what lies outside the axes,
     so a legend placed beside the data, where it hides none, is never cut off."""
-    if layout:
+    if layout and fig.get_layout_engine() is None:  # a constrained-layout figure lays itself out
         fig.tight_layout()
     fig.savefig(path, dpi=dpi, bbox_inches="tight", pad_inches=0.1)
     pyplot().close(fig)
