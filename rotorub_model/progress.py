@@ -1,0 +1,58 @@
+"""What a long command says while it works: stage lines and a heartbeat, on stderr (stdout carries only the
+command's verdict, or its JSON with ``--json``).
+
+Rule (issue 25.3): no silent stretch longer than 10 s. Loops with a count show a tqdm bar; a stage without one
+(a solver, a compilation, a picker) runs inside :func:`stage`, which names it, says every HEARTBEAT_S seconds that
+it is still running, and ends with its time. Lines go through ``tqdm.write``: a bar being drawn is cleared and
+redrawn around them, so a line never lands in the middle of a bar or of another thread's line.
+
+>>> with stage("a short stage", enabled=False):
+...     pass
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+HEARTBEAT_S = 8.0  # below the 10 s a user waits without a word
+_LOCK = threading.Lock()
+
+
+def say(msg: str, prefix: str = "rotorub") -> None:
+    """One line on stderr, whole (threads' lines never run into each other), around any tqdm bar."""
+    from tqdm import tqdm
+
+    with _LOCK:
+        tqdm.write(f"[{prefix}] {msg}" if prefix else msg, file=sys.stderr)
+        sys.stderr.flush()
+
+
+@contextmanager
+def stage(what: str, enabled: bool = True, prefix: str = "rotorub", heartbeat: float = HEARTBEAT_S,
+          done: bool = True) -> Iterator[None]:
+    """Announce ``what``, say every ``heartbeat`` seconds that it is still running, and (``done``) its time at the
+    end; nothing at all when not ``enabled`` (a library call with progress off)."""
+    if not enabled:
+        yield
+        return
+    t0 = time.perf_counter()
+    stop = threading.Event()
+
+    def beat() -> None:
+        while not stop.wait(heartbeat):
+            say(f"{what}: still running ({time.perf_counter() - t0:.0f} s)", prefix)
+
+    say(f"{what} ...", prefix)
+    thread = threading.Thread(target=beat, daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        thread.join(timeout=1.0)
+    if done:
+        say(f"{what}: done in {time.perf_counter() - t0:.1f} s", prefix)
