@@ -15,7 +15,10 @@ import numpy as np
 
 
 def _step(msg: str) -> None:
-    print(f"[reproduce] {msg}", flush=True)
+    """A stage of the FMU half, on stderr (stdout holds the verdict, or the JSON with --json)."""
+    from rotorub_model.progress import say
+
+    say(msg, "reproduce")
 
 
 def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: str | Path = "fmus",
@@ -89,7 +92,35 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
         *[(t, str(Path("coupled") / p)) for t, p in coupled.get("figures", [])],
         *[(t, str(Path("coupled_wear") / p)) for t, p in wear.get("figures", [])],
     ]
-    return {"summary": res, "markdown": report_section(res)}
+    return {"summary": res, "markdown": report_section(res), "verdict": verdict_lines(res)}
+
+
+def verdict_lines(s: dict) -> list[str]:
+    """The FMU half's lines of the main job's verdict: the FMU against the library, the two flavours, the engine
+    scenarios."""
+    lines = [f"FMU checks: native FMU ({', '.join(s['fmu']['platforms'])}) against the library, largest relative "
+             f"difference {s['fmu_vs_library_max_rel_diff']:.2g} (transients, run-up, quasi-static maps under the same "
+             "held inputs)"]
+    fl = s.get("fmu_flavours")
+    if fl:
+        same = all(fl[f]["bit_identical"] for f in ("2D", "3D"))
+        lines.append("  native and pythonfmu FMUs: " + ("the same numbers bit for bit" if same else
+                     f"differ by up to {max(fl[f]['native_vs_pythonfmu'] for f in ('2D', '3D')):.2g}"))
+    tr = s["harnesses"]["transient"]
+    lines.append("  section 6 through the FMU: " + "; ".join(
+        f"{f} diverged: {_fmt(tr[f].get('diverged'))} (penetration limit {_fmt(tr[f].get('penetration_limit_hit'))}, "
+        f"envelope growing {_fmt(tr[f].get('envelope_growing'))})" for f in ("2D", "3D")))
+    c = s.get("coupled_run")
+    if c:
+        lines.append(f"  engine (spool + contact FMUs): the rub costs the spool up to "
+                     f"{_fmt(c.get('min_spool_speed_dip_rad_s'))} rad/s, largest contact force "
+                     f"{_fmt(c.get('max_contact_force_N'))} N")
+    w = s.get("coupled_wear_run")
+    if w:
+        lines.append(f"  engine with wear: the closing clearance cuts the liner {w['wear_depth_max_mm'] * 1e3:.3g} µm "
+                     f"deep; the engine keeps {w['clearance_effective_end_mm']:.4g} mm (fmpy, libcosim, C master "
+                     "agree)")
+    return lines
 
 
 # ---------------------------------------------------------------------------------------------- the report's section

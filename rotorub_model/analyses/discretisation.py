@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..plotting import pyplot, save_figure
+from ..plotting import pyplot
 from ..structure.blades import bladed_disk_matrices
 from ..structure.params import Parameters
 from ..writing import save_result
@@ -150,7 +150,7 @@ class BladeConvergence:
         rows.append(f"| {N_CONVERGED} (converged) | {N_CONVERGED} | {N_CONVERGED} | 0 | 0 | {ref_top:.0f} Hz |")
         return "\n".join(rows)
 
-    def plot(self, path: str | Path) -> Path:
+    def figure(self):
         """Error against n: one colour per number of functions in both panels (flap solid, lag dashed; the
         reduced bases in their n_ritz's colour, a line style and marker per n_modes), legends outside."""
         from ..plotting import legend_outside
@@ -188,7 +188,7 @@ class BladeConvergence:
         for ax in axes:
             ax.grid(alpha=0.3, which="both")
             legend_outside(ax)
-        return save_figure(fig, path)
+        return fig
 
     def save(self, out: str | Path) -> dict:
         s = save_result(self, out, "blade_convergence")

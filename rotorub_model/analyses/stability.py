@@ -61,6 +61,13 @@ class StabilityResult:
             ax.scatter(lam.real[bad], np.abs(lam.imag[bad]) / (2 * np.pi), s=30, color="C3", marker="D",
                        label="Re λ > 0 (unstable)")
         ax.set_xscale("symlog", linthresh=1e-3)
+        # every other decade, labelled at an angle (a symlog axis labels every decade, and they overlap)
+        lo, hi = float(lam.real.min()), float(lam.real.max())
+        neg = [-(10.0 ** k) for k in range(int(np.ceil(np.log10(-lo))), -4, -2)] if lo < -1e-3 else []
+        pos = [10.0 ** k for k in range(-3, int(np.ceil(np.log10(hi))) + 1, 2)] if hi > 1e-3 else []
+        ticks = [*neg, 0.0, *pos]
+        ax.set_xticks(ticks, [("0" if t == 0 else f"{t:.0e}".replace("e+0", "e").replace("e-0", "e-")) for t in ticks],
+                      rotation=40, fontsize=7.5)
         ax.axvspan(-1e-3, 1e-3, color="0.92", zorder=0, label="linear axis within ±1e-3 1/s")
         ax.axvline(0, color="k", lw=0.8)
         ax.set_xlabel("real part Re λ [1/s] (symmetric log axis)")

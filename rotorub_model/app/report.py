@@ -270,13 +270,26 @@ def write_report(out: str | Path, summary: dict, sections: tuple[str, ...] | lis
     if not failing:
         lines.append("Every fact holds on this configuration.")
     for f in failing:
-        lines.append(f"* Fact {f['id']}: {f.get('why', 'see the values in the table and docs/THEORY.md')}")
+        failed = [c for c in f.get("conditions", []) if not c["holds"]]
+        if not failed:
+            lines.append(f"* Fact {f['id']}: {f.get('why', 'see the values in the table and docs/THEORY.md')}")
+            continue
+        lines.append(f"* Fact {f['id']}: {len(failed)} of its {len(f['conditions'])} conditions fail:")
+        for c in failed:
+            whose = (" — a number of the paper's rotor: another configuration need not have it, not a defect of this "
+                     "one" if c["kind"] == "the paper's rotor" else " — the paper's finding does not hold here")
+            lines.append(f"  * {c['condition']}: ours {c['ours']}{whose}")
+        if f.get("note"):  # a fact's further explanation, where it has one
+            lines.append(f"  * {f['note']}")
     if "wear" in summary:
         lines += _wear_section(summary["wear"])
     if "continuation" in summary:
         lines += _continuation_section(summary["continuation"])
     if "blade_discretisation" in summary:
         lines += _discretisation_section(summary["blade_discretisation"])
+    for rel in summary.get("report_sections", []):  # sections the library's quick studies wrote next to their files
+        if (out / rel).is_file():
+            lines += ["", *(out / rel).read_text().rstrip("\n").split("\n")]
     for section in sections:
         lines += section.rstrip("\n").split("\n")
     lines += ["", "## Figures", ""]

@@ -5,7 +5,6 @@ one stable.
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,11 +25,14 @@ from ..analyses.transient import (  # noqa: F401 - the growth verdict's names, u
 from ..contact import make_contact
 from ..errors import ParameterError
 from ..plotting import pyplot, save_figure
+from ..progress import say, stage
 from ..structure.model import Model
 from ..writing import write_json
 
 PAPER_POINT = (3.3, 0.8e-3)  # the paper's transient point (normalised speed, g0 [m])
 PAPER_PARTIAL = 0.88  # the paper's third blade touches over 88 % of its chord at that point
+QUICK_GRID = (40, 36)  # the quick maps' speeds x clearances (the clearances spaced quadratically)
+FULL_GRID = (100, 100)
 
 
 def first_critical(model: Model) -> tuple[float, float]:
@@ -68,8 +70,8 @@ def default_grid(model: Model, quick: bool) -> tuple[np.ndarray, np.ndarray]:
     lo, hi = max(c1 - 0.8, 0.05), min(c1 + 0.8, model.params.normalisation.speed_max)
     gmax = 1.6 * peak
     if quick:
-        return np.linspace(lo, hi, 40), gmax * np.linspace(0.0, 1.0, 36) ** 2
-    return np.linspace(lo, hi, 100), np.linspace(0.0, gmax, 100)
+        return np.linspace(lo, hi, QUICK_GRID[0]), gmax * np.linspace(0.0, 1.0, QUICK_GRID[1]) ** 2
+    return np.linspace(lo, hi, FULL_GRID[0]), np.linspace(0.0, gmax, FULL_GRID[1])
 
 
 def run_stability_study(model: Model, out: str | Path, quick: bool = False, speeds=None, g0s=None,
@@ -422,10 +424,13 @@ def run_transient_study(model: Model, out: str | Path, speed: float | None = Non
         raise ParameterError("transient point: give both --speed and --g0, or neither (automatic choice)")
     point = None
     if speed is None:
-        point = choose_transient_point(model, stab_dir, progress=progress, t_end=t_end)
+        with stage("transient: picking the point (2D unstable, 3D stable) from this configuration", progress):
+            point = choose_transient_point(model, stab_dir, progress=progress, t_end=t_end)
         speed, g0 = point.speed, point.g0
+        if progress:
+            say(f"transient: point Ω = {speed:.4g} Ω_ref, g0 = {g0 * 1e3:.4g} mm ({point.source})")
         if point.note:
-            print(f"rotorub transient: {point.note}", file=sys.stderr)
+            say(f"transient: {point.note}")
     omega = speed * model.params.normalisation.omega_ref
     statics = point_status(model, speed, g0)
     runs = {f: run_transient(model, make_contact(model, f, g0=g0), omega, t_end=t_end, progress=progress)
@@ -443,7 +448,8 @@ def run_wear_study(model: Model, out: str | Path, speed: float | None = None, g0
     if (speed is None) != (g0 is None):
         raise ParameterError("wear point: give both --speed and --g0, or neither (the transient study's point)")
     if speed is None:
-        speed, g0 = pick_transient_point(model, stab_dir, progress=progress, t_end=t_end)
+        with stage("wear: picking the transient study's point", progress):
+            speed, g0 = pick_transient_point(model, stab_dir, progress=progress, t_end=t_end)
     out = Path(out)
     summary = {"speed": speed, "g0_mm": g0 * 1e3}
     for f in ("2D", "3D"):
@@ -466,9 +472,12 @@ def run_continuation_study(model: Model, out: str | Path, speed: float | None = 
             raise ParameterError(f"maps: {exc.filename} not found; run `rotorub stability --out DIR` first") from None
     else:
         speeds, g0s = default_grid(model, quick=True)
+        if progress:
+            say("continuation: no --maps given: computing the quick stability maps first")
         maps = {f: run_stability_map(model, f, speeds, g0s, progress=progress) for f in ("2D", "3D")}
     r = run_continuation(model, maps=maps, speed=speed, quick=quick, progress=progress)
     s = r.save(out)
-    return {f: {"specials": s[f]["specials"], "boundary": s[f]["boundary"],
-                "orbits": [len(b["orbits"]) for b in s[f]["orbit_branches"]]} for f in ("2D", "3D")} | \
-        {"written": str(Path(out) / "summary.json")}
+    for f in ("2D", "3D"):  # the orbits' count per branch, as the report tabulates them
+        if f in s:
+            s[f]["orbits"] = [len(b["orbits"]) for b in s[f]["orbit_branches"]]
+    return s
