@@ -69,12 +69,22 @@ def _run_build(ns: argparse.Namespace) -> dict:
 
 
 def reproduce_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: str | Path = "fmus",
-                       params_file: str | Path | None = None, progress: bool = True) -> dict:
-    """The FMU half of ``rotorub reproduce`` (reproduce.py): returns ``{"summary": ..., "markdown": ...}``, the
-    additions to the summary and the report's section about them."""
+                       params_file: str | Path | None = None, progress: bool = True, builds=None) -> dict:
+    """The FMU half of ``rotorub reproduce`` (reproduce.py): returns ``{"summary": ..., "markdown": ...,
+    "verdict": ...}``, the additions to the summary, the report's section about them and the verdict's lines;
+    ``builds``: what :func:`start_fmu_builds` returned, when the FMUs were started before the library's analyses."""
     from .reproduce import run_fmu_part
 
-    return run_fmu_part(model, out, summary, quick, fmu_dir=fmu_dir, params_file=params_file, progress=progress)
+    return run_fmu_part(model, out, summary, quick, fmu_dir=fmu_dir, params_file=params_file, progress=progress,
+                        builds=builds)
+
+
+def start_fmu_builds(fmu_dir: str | Path = "fmus", params_file: str | Path | None = None):
+    """Start building the main job's FMUs in the background (entry point ``rotorub.reproduce: fmu-builds``): the
+    compilations run beside the library's analyses. Returns the handle :func:`reproduce_fmu_part` takes."""
+    from .reproduce import start_builds
+
+    return start_builds(fmu_dir, params_file)
 
 
 # (name, help, add_arguments, run): what rotorub_model.app.cli registers for each entry point

@@ -14,25 +14,62 @@ from typing import Any
 import numpy as np
 
 
-def _step(msg: str) -> None:
-    """A stage of the FMU half, on stderr (stdout holds the verdict, or the JSON with --json)."""
-    from rotorub_model.progress import say
+def _step(msg: str, progress: bool = True):
+    """A stage of the FMU half, on stderr (stdout holds the verdict, or the JSON with --json): announced, a heartbeat
+    while it runs, its time at the end."""
+    from rotorub_model.progress import stage
 
-    say(msg, "reproduce")
+    return stage(msg, progress, prefix="reproduce")
+
+
+def build_all(fmu_dir: str | Path = "fmus", params_file: str | Path | None = None) -> dict:
+    """Every FMU the FMU half runs, for this machine only: both flavours of the contact FMU (with their cross-check
+    kits), the spool FMU of the coupled scenario and the three FMUs of the scenario with wear.
+
+    This machine's only, because the harnesses, the masters and the C hosts all run here: a cold ziglang cache
+    compiles each target's C library first (measured on 2 cores: linux64 17 s, aarch64-linux 22 s, darwin64 17 s,
+    win64 148 s on a loaded machine), which alone would take the main job past its 3 minutes. ``rotorub build-fmu
+    --native`` builds the five platforms (README, "The FMUs")."""
+    from .cli import build
+    from .fmi.compile import host_platform
+    from .models.spool.builder import build_native_spool_fmu
+    from .systems.coupling import scenario_settings
+    from .systems.wear_scenario import build_wear_fmus
+
+    plats = (host_platform(),)
+    fmu_dir = Path(fmu_dir)
+    return {"platforms": plats, "pythonfmu": build(fmu_dir, params_file, platforms=plats),
+            "native": build(fmu_dir / "native", params_file, native=True, platforms=plats),
+            "spool": build_native_spool_fmu(fmu_dir / "native", platforms=plats),
+            "wear": build_wear_fmus(fmu_dir / "wear", platforms=plats,
+                                    omega0=scenario_settings(True)["spool_params"]["Omega0"])}
+
+
+def start_builds(fmu_dir: str | Path = "fmus", params_file: str | Path | None = None):
+    """:func:`build_all` in a background thread, started before the library's analyses: the compilations are
+    other processes (ziglang, the C compiler), so they run beside the analyses' Python instead of after them (a
+    cold build is half a minute). Returns a future; :func:`run_fmu_part` takes it (``builds=``)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="fmu-builds")
+    future = pool.submit(build_all, fmu_dir, params_file)
+    pool.shutdown(wait=False)
+    return future
 
 
 def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: str | Path = "fmus",
-                 params_file: str | Path | None = None, progress: bool = True) -> dict:
+                 params_file: str | Path | None = None, progress: bool = True, builds=None) -> dict:
     """``{"summary": additions to the summary (harness results, fmu_vs_library_max_rel_diff, coupled_run, ...),
-    "markdown": the report's section about them}``."""
-    from .cli import build
+    "markdown": the report's section about them, "verdict": its lines of the main job's verdict}``. ``builds``: a
+    :func:`start_builds` future (the FMUs built while the library's analyses ran), else they are built here."""
     from .masters.analyses import compare_flavours, quasi_static_maps, run_up, transient_pair
 
     out = Path(out)
-    _step(f"building both FMU flavours (pythonfmu into {fmu_dir}/, native C into {fmu_dir}/native/), with their "
-          "cross-check kits")
-    info_py = build(fmu_dir, params_file)
-    info = build(Path(fmu_dir) / "native", params_file, native=True)
+    with _step(f"the FMUs for this machine (`rotorub build-fmu` builds every platform): pythonfmu into {fmu_dir}/, "
+               f"native C into {fmu_dir}/native/, the engine's in {fmu_dir}/wear/, with their cross-check kits"
+               + (" (built while the library's analyses ran)" if builds is not None else ""), progress):
+        built = builds.result() if builds is not None else build_all(fmu_dir, params_file)
+    plats, info_py, info = built["platforms"], built["pythonfmu"], built["native"]
     fmu = info["fmu"]  # the product: the harnesses run it; the pythonfmu one is compared with it below
     res: dict = {"fmu": {"file": fmu, "guid": info["guid"], "platforms": info["platforms"],
                          "variables": info["variables"], "pythonfmu_file": info_py["fmu"]}}
@@ -43,25 +80,27 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
     n_sp, n_g = (20, 16) if quick else (60, 40)
     speeds = np.linspace(max(w - 0.8, 0.05), w + 0.8, n_sp)
     g0s = gmax * np.linspace(0.0, 1.0, n_g) ** 2
-    _step(f"quasi-static sweeps through the FMU ({n_sp} speeds x {n_g} clearances x 2D/3D) vs the library maps")
-    qs = quasi_static_maps(fmu, model, speeds, g0s, out / "fmu_quasi_static", progress=progress)
-    qsum = qs.save(out / "fmu_quasi_static")
+    with _step(f"quasi-static sweeps through the FMU ({n_sp} speeds x {n_g} clearances x 2D/3D) vs the library maps",
+               progress):
+        qs = quasi_static_maps(fmu, model, speeds, g0s, out / "fmu_quasi_static", progress=progress)
+        qsum = qs.save(out / "fmu_quasi_static")
 
     tr = summary["transient"]
     speed, g0 = float(tr["speed"]), float(tr["g0_mm"]) * 1e-3
     t_end = float(tr.get("t_end_s", 20.0))
-    _step(f"section 6 transients through the FMU at speed {speed:.3g}, g0 = {g0 * 1e3:.3g} mm, {t_end:g} s")
-    pair = transient_pair(fmu, model, speed, g0, out / "fmu_transient", t_end=t_end, progress=progress)
+    with _step(f"section 6 transients through the FMU at speed {speed:.3g}, g0 = {g0 * 1e3:.3g} mm, {t_end:g} s",
+               progress):
+        pair = transient_pair(fmu, model, speed, g0, out / "fmu_transient", t_end=t_end, progress=progress)
     agree = {f: pair[f]["diverged"] == bool(tr.get(f"diverged_{f.lower()}", pair[f]["diverged"]))
              for f in ("2D", "3D")}
     pair["same_verdict_as_library_study"] = agree
 
-    _step("run-up through the first critical speed through the FMU (Omega(t) as input)")
-    ru = run_up(fmu, model, out / "fmu_run_up", speed_from=max(w - 0.9, 0.1), speed_to=w + 0.9,
-                duration=4.0 if quick else 8.0, progress=progress)
+    with _step("run-up through the first critical speed through the FMU (Omega(t) as input)", progress):
+        ru = run_up(fmu, model, out / "fmu_run_up", speed_from=max(w - 0.9, 0.1), speed_to=w + 0.9,
+                    duration=4.0 if quick else 8.0, progress=progress)
 
-    _step("the two flavours on the same section-6 scenario (3 s): native vs pythonfmu vs library")
-    res["fmu_flavours"] = compare_flavours(fmu, info_py["fmu"], model, speed, g0, out / "fmu_flavours")
+    with _step("the two flavours on the same section-6 scenario (3 s): native vs pythonfmu vs library", progress):
+        res["fmu_flavours"] = compare_flavours(fmu, info_py["fmu"], model, speed, g0, out / "fmu_flavours")
 
     diffs = [pair["2D"]["max_rel_diff_F_N_vs_library"], pair["3D"]["max_rel_diff_F_N_vs_library"],
              ru["max_rel_diff_F_N_vs_library"], ru["max_rel_diff_disk_vs_library"]]
@@ -77,13 +116,14 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
     from .systems.coupling import run_coupled_scenario
     from .systems.wear_scenario import run_wear_scenario
 
-    _step("coupled engine scenario: LP spool FMU + contact FMU, fmpy master loop, SSP file")
-    coupled = run_coupled_scenario(out / "coupled", quick=quick, contact_fmu=fmu, fmu_dir=fmu_dir)
+    with _step("coupled engine scenario: LP spool FMU + contact FMU, fmpy master loop, SSP file", progress):
+        coupled = run_coupled_scenario(out / "coupled", quick=quick, contact_fmu=fmu, spool_fmu=built["spool"],
+                                       fmu_dir=fmu_dir, platforms=plats)
     res["coupled_run"] = coupled
 
-    _step("engine scenario with wear: spool + clearance closure + contact with its abradable liner (SSP, three "
-          "masters)")
-    wear = run_wear_scenario(out / "coupled_wear", quick=quick, fmu_dir=Path(fmu_dir) / "wear" if fmu_dir else None)
+    with _step("engine scenario with wear: spool + clearance closure + contact with its abradable liner (SSP, three "
+               "masters)", progress):
+        wear = run_wear_scenario(out / "coupled_wear", quick=quick, fmus=built["wear"], platforms=plats)
     res["coupled_wear_run"] = {k: v for k, v in wear.items() if k != "figures"}
     res["figures_extra"] = [
         ("Contact and stability maps through the FMU (quasi-static sweeps)", "fmu_quasi_static/fmu_maps.png"),

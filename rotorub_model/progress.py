@@ -20,6 +20,17 @@ from contextlib import contextmanager
 
 HEARTBEAT_S = 8.0  # below the 10 s a user waits without a word
 _LOCK = threading.Lock()
+_LAST = [0.0]  # when the last line was said (a heartbeat stays quiet while something else speaks)
+
+
+def _quiet_for() -> float:
+    """Seconds since anything was last shown: a line said here, or a tqdm bar redrawn."""
+    from tqdm import tqdm
+
+    last = _LAST[0]
+    for bar in list(getattr(tqdm, "_instances", [])):
+        last = max(last, float(getattr(bar, "last_print_t", 0.0) or 0.0))
+    return time.time() - last
 
 
 def say(msg: str, prefix: str = "rotorub") -> None:
@@ -29,6 +40,7 @@ def say(msg: str, prefix: str = "rotorub") -> None:
     with _LOCK:
         tqdm.write(f"[{prefix}] {msg}" if prefix else msg, file=sys.stderr)
         sys.stderr.flush()
+        _LAST[0] = time.time()
 
 
 @contextmanager
@@ -43,8 +55,10 @@ def stage(what: str, enabled: bool = True, prefix: str = "rotorub", heartbeat: f
     stop = threading.Event()
 
     def beat() -> None:
-        while not stop.wait(heartbeat):
-            say(f"{what}: still running ({time.perf_counter() - t0:.0f} s)", prefix)
+        # every second, a line when nothing (this stage, an inner one, a progress bar) has spoken for `heartbeat`
+        while not stop.wait(1.0):
+            if _quiet_for() >= heartbeat:
+                say(f"{what}: still running ({time.perf_counter() - t0:.0f} s)", prefix)
 
     say(f"{what} ...", prefix)
     thread = threading.Thread(target=beat, daemon=True)

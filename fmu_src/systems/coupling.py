@@ -430,18 +430,20 @@ def scenario_settings(quick: bool = True) -> dict:
 
 def run_coupled_scenario(out_dir: str | Path, quick: bool = True, contact_fmu: str | Path | None = None,
                          spool_fmu: str | Path | None = None, progress: bool = False,
-                         fmu_dir: str | Path | None = None) -> dict:
+                         fmu_dir: str | Path | None = None, platforms: tuple[str, ...] | None = None) -> dict:
     """Build the FMUs (unless given: the native contact and spool FMUs, no Python on a host), write and
     validate the SSP, run the rub-free and the rub cases in the fmpy master loop, the rub case's SSP in libcosim
     and in the C master (no Python in the process), and save ``no_rub.npz``, ``rub.npz``, ``coupled_runup.png``,
-    ``summary.json`` in ``out_dir``."""
+    ``summary.json`` in ``out_dir``. ``platforms``: the binaries of the FMUs it builds (None: every platform;
+    the main job: this machine's, the one it runs)."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     cfg = scenario_settings(quick)
     t0 = time.perf_counter()
     fmu_dir = Path(fmu_dir) if fmu_dir else out / "fmus"
-    contact_fmu = Path(contact_fmu) if contact_fmu else Path(build_native_fmu(fmu_dir / "native")["fmu"])
-    spool_fmu = Path(spool_fmu) if spool_fmu else build_native_spool_fmu(fmu_dir / "native")
+    contact_fmu = Path(contact_fmu) if contact_fmu else Path(build_native_fmu(fmu_dir / "native",
+                                                                              platforms=platforms)["fmu"])
+    spool_fmu = Path(spool_fmu) if spool_fmu else build_native_spool_fmu(fmu_dir / "native", platforms=platforms)
     build_s = time.perf_counter() - t0
     ssp = write_ssp(out / "RotorRubEngine.ssp", contact_fmu, spool_fmu, g0=cfg["g0_rub"], imbalance=cfg["imbalance"],
                     formulation=cfg["formulation"], spool_params=cfg["spool_params"], t_end=cfg["t_end"], h=cfg["h"])

@@ -451,17 +451,24 @@ def cmd_reproduce(ns: argparse.Namespace) -> Done:
     from .reproduce import main_job_verdict, run_reproduce
 
     model = _model(ns)
-    s = run_reproduce(model, ns.out, quick=ns.quick, params_file=ns.params, progress=True)
-    fmu_lines: list[str] = []
+    builds = None
     if not ns.no_fmu:
         from ..errors import ParameterError
 
-        try:
+        try:  # the FMU half found (or refused) before any work
             run_fmu_part = _entry_point("rotorub.reproduce", "fmu")
         except (LookupError, ImportError) as exc:
             raise ParameterError(f"reproduce: the FMU part needs the fmu extra ({exc}); "
                                  "pip install -e '.[fmu]', or run with --no-fmu") from None
-        part = run_fmu_part(model, ns.out, s, quick=ns.quick, fmu_dir=ns.fmu_dir, params_file=ns.params)
+        try:  # its compilations beside the library's analyses (an older FMU side builds them afterwards)
+            builds = _entry_point("rotorub.reproduce", "fmu-builds")(ns.fmu_dir, ns.params)
+        except (LookupError, ImportError):
+            builds = None
+    s = run_reproduce(model, ns.out, quick=ns.quick, params_file=ns.params, progress=True)
+    fmu_lines: list[str] = []
+    if not ns.no_fmu:
+        kw = {"builds": builds} if builds is not None else {}
+        part = run_fmu_part(model, ns.out, s, quick=ns.quick, fmu_dir=ns.fmu_dir, params_file=ns.params, **kw)
         s.update(part["summary"])
         from ..writing import write_json
         from .report import write_report

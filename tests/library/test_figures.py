@@ -4,13 +4,11 @@ without a solution (solved from a contact-set start, proven absent, or the solve
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from matplotlib.colors import to_rgb
 
-from rotorub_model.analyses import discretisation, maps, transient
+from rotorub_model.analyses import discretisation, maps
 from rotorub_model.analyses.detection import run_detection
 from rotorub_model.analyses.maps import NO_EQUILIBRIUM, NOT_CONVERGED, ContactSetStarts, run_stability_map
 from rotorub_model.analyses.transient import run_transient
@@ -28,22 +26,20 @@ def det(ref_model):
 
 
 @pytest.fixture
-def captured(monkeypatch):
-    """Figures handed to save_figure by the plot methods, laid out and drawn, kept open for inspection."""
+def captured():
+    """Figures the tests draw through the result objects' figure(), laid out, drawn, closed at the end."""
     figs = []
-
-    def keep(fig, path, dpi: int = 120, layout: bool = True) -> Path:
-        if layout:
-            fig.tight_layout()
-        fig.canvas.draw()
-        figs.append(fig)
-        return Path(path)
-
-    for mod in (transient, studies, discretisation, maps):
-        monkeypatch.setattr(mod, "save_figure", keep)
     yield figs
     for f in figs:
         pyplot().close(f)
+
+
+def _drawn(figs: list, fig):
+    if fig.get_layout_engine() is None:
+        fig.tight_layout()
+    fig.canvas.draw()
+    figs.append(fig)
+    return fig
 
 
 def _legends(fig) -> list:
@@ -152,8 +148,8 @@ def test_proven_absence_and_failure_are_told_apart(stiff, monkeypatch, captured)
     s2, s3 = got["2D"].summary(), got["3D"].summary()
     assert (s2["no_equilibrium_points"], s2["not_converged_points"]) == (2, 0)
     assert (s3["no_equilibrium_points"], s3["not_converged_points"]) == (0, 2)
-    studies._plot_pair(got, Path("unused.png"))
-    labels = [t.get_text() for t in captured[-1].legends[0].get_texts()]
+    fig = _drawn(captured, maps.maps_figure(got))
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
     assert any(lab.startswith("no equilibrium") for lab in labels)
     assert any(lab.startswith("solver did not converge") for lab in labels)
 
@@ -175,8 +171,7 @@ def test_stable_and_unstable_cells_cannot_be_confused(stiff, captured):
     m, speeds, g0s = stiff
     mp = run_stability_map(m, "3D", speeds[[20, 22, 27]], g0s, executor="serial", progress=False)
     assert mp.unstable.any() and (mp.contact & ~mp.unstable).any()
-    mp.plot(Path("unused.png"))
-    fig = captured[-1]
+    fig = _drawn(captured, mp.figure())
     stable = np.array(to_rgb(maps.STABLE_COLOUR))
     scale = maps.unstable_cmap()(np.linspace(0.0, 1.0, 256))[:, :3]
     assert np.min(np.linalg.norm(scale - stable, axis=1)) > 0.5  # not one shade of the scale is near it
@@ -194,8 +189,8 @@ def test_stable_and_unstable_cells_cannot_be_confused(stiff, captured):
 def test_transient_legends_are_outside_the_data(ref_model, captured):
     runs = {f: run_transient(ref_model, make_contact(ref_model, f, g0=0.2e-3), 3.3 * 53.4, t_end=1.2)
             for f in ("2D", "3D")}
-    runs["2D"].plot(Path("unused.png"))
-    studies.TransientStudy(3.3, 0.2e-3, runs, {}).plot(Path("unused.png"))
+    _drawn(captured, runs["2D"].figure())
+    _drawn(captured, studies.TransientStudy(3.3, 0.2e-3, runs, {}).figure())
     assert len(captured) == 2
     for fig in captured:
         assert_legends_hide_nothing(fig)
@@ -207,5 +202,4 @@ def test_transient_legends_are_outside_the_data(ref_model, captured):
 
 def test_discretisation_legends_are_outside_the_data(captured):
     res = discretisation.run_blade_convergence(reference_parameters(), n_values=(2, 3), n_speeds=3)
-    res.plot(Path("unused.png"))
-    assert_legends_hide_nothing(captured[-1])
+    assert_legends_hide_nothing(_drawn(captured, res.figure()))
