@@ -302,8 +302,21 @@ def _rel_diff(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.abs(a[:m] - b[:m]).max() / scale) if m else 0.0
 
 
-def _plot_forces(runs: dict[str, FMURun], path: Path, title: str, diverged: dict[str, bool]) -> Path:
-    """One panel per formulation; a blade keeps its colour in every panel, legends right of the data."""
+def _verdict(s: dict) -> str:
+    """A run's verdict in words, the two meanings apart (as in the library's transient figures)."""
+    g = s.get("envelope_growth") or {}
+    if s.get("penetration_limit_hit"):
+        return "diverged: the penetration limit was hit"
+    if g.get("factor") is None:
+        return "no growth verdict (a run shorter than 4 s)"
+    return (("diverged: " if s.get("envelope_growing") else "not diverging: ")
+            + f"force envelope ×{g['factor']:.3g} over {g['window_s'][0]:.3g}-{g['window_s'][1]:.3g} s "
+            f"({g['rate_per_s']:+.3g} 1/s)")
+
+
+def _plot_forces(runs: dict[str, FMURun], path: Path, title: str, verdicts: dict[str, str]) -> Path:
+    """One panel per formulation, its verdict in its title; a blade keeps its colour in every panel, legends right
+    of the data."""
     from rotorub_model.plotting import legend_outside, plot_blade_forces
 
     plt = pyplot()
@@ -311,7 +324,7 @@ def _plot_forces(runs: dict[str, FMURun], path: Path, title: str, diverged: dict
     for ax, (f, r) in zip(axes[:, 0], runs.items()):
         plot_blade_forces(ax, r.t, r.F_N, lw=0.8)
         ax.set_ylabel("normal contact force F_N [N]")
-        ax.set_title(f"{f}: {title}" + (" — diverged" if diverged[f] else ""))
+        ax.set_title(f"{f}: {title}\n{verdicts[f]}", fontsize=9)
         ax.grid(alpha=0.3)
         legend_outside(ax)
     axes[-1, 0].set_xlabel("time [s]")
@@ -360,7 +373,7 @@ def transient_pair(fmu: str | Path, model, speed: float, g0: float, out: str | P
             "max_rel_diff_F_N_vs_library": _rel_diff(r.F_N, lib.outputs["F_N"]),
         }
     _plot_forces(runs, out / "fmu_contact_forces.png", f"normal contact forces through the FMU, "
-                 f"Ω = {speed:.3g} Ω_ref, g0 = {g0 * 1e3:.3g} mm", {f: summary[f]["diverged"] for f in runs})
+                 f"Ω = {speed:.3g} Ω_ref, g0 = {g0 * 1e3:.3g} mm", {f: _verdict(summary[f]) for f in runs})
     np.savez_compressed(out / "fmu_transients.npz", **{f"{f}_{k}": getattr(r, k) for f, r in runs.items()
                                                         for k in ("t", "F_N", "fraction", "friction_torque")})
     write_json(out / "summary.json", summary)
