@@ -24,7 +24,8 @@ def test_transient_pair_matches_library_and_saves_fig12(fmu, ref_model, tmp_path
         assert s[f]["max_normal_force_N"] > 50.0  # it rubs
         assert s[f]["max_rel_diff_F_N_vs_library"] < 1e-9
         assert s[f]["penetration_limit_hit"] == s[f]["library_penetration_limit_hit"]
-        assert s[f]["envelope_growing"] is None and s[f]["diverged"] is s[f]["penetration_limit_hit"]  # 1.5 s: no fit
+        # 1.5 s: no growth verdict, and the limit was not hit: no verdict at all (null), not a false "no"
+        assert s[f]["envelope_growing"] is None and s[f]["diverged"] is None
     assert (tmp_path / "fmu_contact_forces.png").stat().st_size > 10_000
     assert json.loads((tmp_path / "summary.json").read_text())["speed"] == 3.3
 
