@@ -89,11 +89,12 @@ def report(wall: float, lines: list[tuple[float, str, str]], code: int, label: s
     stamps = [0.0, *(t for t, _, _ in lines), wall]
     gaps = sorted(((b - a, a) for a, b in zip(stamps, stamps[1:])), reverse=True)[:3]
     print("   longest silences: " + ", ".join(f"{g:.1f} s at {a:.0f} s" for g, a in gaps))
-    for g, a in gaps[:1]:
+    if gaps:
+        a = gaps[0][1]
         before = [s for t, _, s in lines if t <= a][-1:] or ["(start)"]
         print(f"   (the longest follows: {before[0][:110]!r})")
     print("   stages (their own 'done in'):")
-    for t, _, s in lines:
+    for _, _, s in lines:
         m = re.match(r"\[(rotorub|reproduce|build-fmu)\] (.*): done in ([0-9.]+) s", s)
         if m and (m.group(1) != "build-fmu" or float(m.group(3)) > 2):
             print(f"     {float(m.group(3)):6.1f} s  {m.group(2)[:100]}")

@@ -31,7 +31,8 @@ def case(form: str, speed: float, mu: float, t_end: float = 1.0, g0: float = 0.2
     cell = 360.0 / len(th)
     half = r.t > 0.5 * r.t[-1]
     ptp = float(np.max(np.ptp(r.outputs["disk_fixed"][half], axis=0))) * 1e6
-    return (f"| {form} | {speed:g} | {mu:g} | {prof.max() * 1e6:.2f} µm ({100 * (prof.max() / exact.max() - 1):+.1f} %) "
+    rel = 100 * (prof.max() / exact.max() - 1)
+    return (f"| {form} | {speed:g} | {mu:g} | {prof.max() * 1e6:.2f} µm ({rel:+.1f} %) "
             f"| {(prof > 0).sum() * cell:.0f}° / {(exact > 0).sum() * cell:.0f}° | {ptp:.1f} µm |")
 
 

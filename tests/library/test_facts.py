@@ -3,8 +3,8 @@ says when the condition is a number of the paper's rotor rather than a defect of
 
 from __future__ import annotations
 
-from rotorub_model.app.reproduce import fact1, fact6, main_job_verdict
 from rotorub_model.app.report import write_report
+from rotorub_model.app.reproduce import fact1, fact6, main_job_verdict
 from rotorub_model.facts import FINDING, ROTOR
 
 
