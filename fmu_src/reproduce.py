@@ -125,6 +125,11 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
                "masters)", progress):
         wear = run_wear_scenario(out / "coupled_wear", quick=quick, fmus=built["wear"], platforms=plats)
     res["coupled_wear_run"] = {k: v for k, v in wear.items() if k != "figures"}
+    if params_file is not None:  # a user's configuration: say what the engine scenarios do not take from it
+        res["engine_scenarios_note"] = (
+            "the engine scenarios keep their own settings whatever --params says: the coupled run drives this "
+            "configuration's contact FMU with the reference's spool schedule (a run-up through the reference's first "
+            "critical speed, 186 rad/s); the scenario with wear runs the embedded reference with its liner on")
     res["figures_extra"] = [
         ("Contact and stability maps through the FMU (quasi-static sweeps)", "fmu_quasi_static/fmu_maps.png"),
         ("Normal contact forces through the FMU, 2D vs 3D (paper Fig. 12)", "fmu_transient/fmu_contact_forces.png"),
@@ -160,6 +165,8 @@ def verdict_lines(s: dict) -> list[str]:
         lines.append(f"  engine with wear: the closing clearance cuts the liner {w['wear_depth_max_mm'] * 1e3:.3g} µm "
                      f"deep; the engine keeps {w['clearance_effective_end_mm']:.4g} mm (fmpy, libcosim, C master "
                      "agree)")
+    if s.get("engine_scenarios_note"):
+        lines.append(f"  note: {s['engine_scenarios_note']}")
     return lines
 
 
@@ -235,6 +242,8 @@ def report_section(s: dict) -> str:
         lines += ["", "## Coupled engine scenario (LP spool FMU + contact FMU)", "",
                   "| quantity | value |", "|---|---|"]
         lines += [f"| {_label(k)} | {_fmt(v)} |" for k, v in c.items() if not isinstance(v, dict | list)]
+    if s.get("engine_scenarios_note"):
+        lines += ["", f"Note: {s['engine_scenarios_note']}."]
     w = s.get("coupled_wear_run")
     if w:
         lines += ["", "## Engine scenario with wear (spool + clearance closure + contact with its liner)", "",
