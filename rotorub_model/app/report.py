@@ -23,6 +23,8 @@ FIGURES = [
     ("Stability boundary by continuation over the grid maps", "continuation/boundaries.png"),
     ("Blades' Ritz discretisation: frequency error against the number of functions",
      "discretisation/blade_convergence.png"),
+    ("Will it rub? The rub probability against the build clearance (quick study)", "uq/tolerances/uq_rub_vs_clearance.png"),
+    ("Mistuned disks: contact against linear amplification (quick study)", "uq/mistuning/uq_mistuning.png"),
 ]
 
 
@@ -274,7 +276,8 @@ def write_report(out: str | Path, summary: dict, sections: tuple[str, ...] | lis
         if not failed:
             lines.append(f"* Fact {f['id']}: {f.get('why', 'see the values in the table and docs/THEORY.md')}")
             continue
-        lines.append(f"* Fact {f['id']}: {len(failed)} of its {len(f['conditions'])} conditions fail:")
+        lines.append(f"* Fact {f['id']}: {len(failed)} of its {len(f['conditions'])} conditions "
+                     + ("fails:" if len(failed) == 1 else "fail:"))
         for c in failed:
             whose = (" — a number of the paper's rotor: another configuration need not have it, not a defect of this "
                      "one" if c["kind"] == "the paper's rotor" else " — the paper's finding does not hold here")
