@@ -23,7 +23,8 @@ FIGURES = [
     ("Stability boundary by continuation over the grid maps", "continuation/boundaries.png"),
     ("Blades' Ritz discretisation: frequency error against the number of functions",
      "discretisation/blade_convergence.png"),
-    ("Will it rub? The rub probability against the build clearance (quick study)", "uq/tolerances/uq_rub_vs_clearance.png"),
+    ("Will it rub? The rub probability against the build clearance (quick study)",
+     "uq/tolerances/uq_rub_vs_clearance.png"),
     ("Mistuned disks: contact against linear amplification (quick study)", "uq/mistuning/uq_mistuning.png"),
 ]
 
