@@ -338,6 +338,11 @@ def cmd_wear(ns: argparse.Namespace) -> Done:
              + (f" ({note})" if note else "") + ":"]
     for f in ("2D", "3D"):
         w = s[f]
+        if w["depth_max_mm"] <= 0:  # nothing cut: say why (the forces stayed below the liner's yield)
+            lines.append(f"  {f}: no wear: the largest normal force, {w['max_normal_force_N']:.4g} N, stays below the "
+                         f"liner's yield force {w['liner']['yield_force_N']:.4g} N; clearance "
+                         f"{w['clearance_before_mm']:.4g} mm kept.")
+            continue
         lines.append(f"  {f}: deepest {w['depth_max_mm'] * 1e3:.4g} µm, {w['removed_volume_mm3']:.4g} mm³ removed, "
                      f"plastic work {w['plastic_work_J']:.4g} J; {w['lobes_verdict']}; clearance "
                      f"{w['clearance_before_mm']:.4g} -> {w['clearance_effective_mm']:.4g} mm.")
