@@ -395,9 +395,10 @@ def cmd_continuation(ns: argparse.Namespace) -> Done:
             continue
         sp = "; ".join(f"{x['kind']} at g0 = {x['g0_m'] * 1e3:.4g} mm" for x in s[f]["specials"]) or "no special point"
         b = s[f]["boundary"]
-        lines.append(f"  {f}: {sp}; {sum(s[f]['orbits'])} periodic orbits ({s[f]['orbit_note']}); boundary "
-                     f"{b.get('curves')} curves, {b.get('contradicting_beyond_one_cell', '?')} grid cells contradict "
-                     "them beyond one cell.")
+        n = b.get("curves") or 0
+        lines.append(f"  {f}: {sp}; {sum(s[f]['orbits'])} periodic orbits ({s[f]['orbit_note']}); stability "
+                     f"boundary: {n} curve{'s' if n != 1 else ''}, {b.get('contradicting_beyond_one_cell', '?')} grid "
+                     "cells contradict them beyond one cell.")
     lines.append(files_line(ns.out))
     return Done(s, lines)
 
