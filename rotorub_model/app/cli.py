@@ -428,8 +428,8 @@ def cmd_forced_response(ns: argparse.Namespace) -> Done:
     f = forcing_from_args(g0, ns.lobe, ns.amplitude, ns.phase, offset)
     s = run_forced_response(m, ns.out, tuple(ns.speeds), ns.formulation, g0, f, ns.harmonics, ns.transients,
                             executor="serial" if ns.executor == "serial" else None)
-    lines = [f"Forced rub response, {ns.formulation}, Ω/Ω_ref {ns.speeds[0]:g}-{ns.speeds[1]:g}, g0 = "
-             f"{g0 * 1e3:.4g} mm: {s['verdict']}.", files_line(ns.out)]
+    lines = [f"Forced rub response over Ω/Ω_ref {ns.speeds[0]:g}-{ns.speeds[1]:g}: {s['verdict']}.",
+             files_line(ns.out)]
     return Done(s, lines)
 
 
