@@ -77,7 +77,7 @@ def run_timed(command: str, cwd: Path, env: dict) -> tuple[float, list[tuple[flo
     code = proc.wait()
     for th in threads:
         th.join()
-    return time.perf_counter() - t0, sorted(lines), code
+    return time.perf_counter() - t0, sorted(lines, key=lambda x: x[0]), code  # stable: each stream's order kept
 
 
 def report(wall: float, lines: list[tuple[float, str, str]], code: int, label: str) -> None:
