@@ -241,7 +241,7 @@ def cmd_static(ns: argparse.Namespace) -> Done:
 
     m = _model(ns)
     st = run_static(m, make_contact(m, ns.formulation, g0=ns.g0), ns.speed * m.params.normalisation.omega_ref)
-    s = {"speed": ns.speed, **st.save(ns.out, "static")}
+    s = {**st.save(ns.out, "static"), "speed": ns.speed}  # the speed as given (omega / omega_ref rounds)
     from ..writing import write_json
 
     write_json(Path(ns.out) / "summary.json", s)

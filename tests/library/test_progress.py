@@ -51,3 +51,15 @@ def test_a_disabled_stage_says_nothing(capsys):
     with progress.stage("quiet", enabled=False):
         pass
     assert capsys.readouterr().err == ""
+
+
+def test_a_short_or_refused_stage_adds_no_line(capsys):
+    """A stage over in less than half a second says nothing; one that fails fast adds nothing to its error line."""
+    with progress.stage("quick"):
+        pass
+    try:
+        with progress.stage("refused"):
+            raise ValueError("bad input")
+    except ValueError:
+        pass
+    assert capsys.readouterr().err == ""
