@@ -424,14 +424,15 @@ def accepted_range(name: str) -> tuple[float, float]:
     parameter file, the FMUs' variables and the CLI); an open lower end is returned as the value itself (the
     callers that declare ranges, FMI among them, know only inclusive bounds: they refuse it separately)."""
     if name in INPUT_RANGES:
-        return INPUT_RANGES[name]
+        lo, hi = INPUT_RANGES[name]
+        return float(lo), float(hi)
     sec, _, fname = name.partition(".")
     cls = _SECTIONS.get(sec) or _LISTS.get(sec)
     f = next((f for f in fields(cls) if f.name == fname), None) if cls else None
     if f is None or "range" not in f.metadata:
         raise KeyError(f"{name}: no declared range")
     lo, hi, _ = f.metadata["range"]
-    return lo, hi
+    return float(lo), float(hi)
 
 
 def describe(name: str) -> str:
