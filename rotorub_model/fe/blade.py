@@ -207,16 +207,32 @@ def _check_tip(fe: FEModel, tip_nodes) -> tuple[np.ndarray, np.ndarray]:
         raise FEImportError(f"tip_nodes: node {int(u[cnt > 1][0])} is given twice")
     key = {(int(a), int(b)): i for i, (a, b) in enumerate(zip(fe.dof_nodes, fe.dof_components))}
     known = set(fe.node_ids.tolist())
-    rows = np.zeros((tips.size, 3), dtype=np.int64)
+    rows = -np.ones((tips.size, 3), dtype=np.int64)  # -1: a constrained translation (no elastic displacement)
     for i, t in enumerate(tips.tolist()):
         if t not in known:
             raise FEImportError(f"tip_nodes: node {t} is not in the model ({fe.source})")
         for c in range(3):
-            if (t, c + 1) not in key:
-                raise FEImportError(f"tip_nodes: node {t} has no free dof {t}.{c + 1} (a clamped node, or one without "
-                                    "translations, cannot be a contact node)")
-            rows[i, c] = key[(t, c + 1)]
+            rows[i, c] = key.get((t, c + 1), -1)
+        if (rows[i] < 0).all():
+            raise FEImportError(f"tip_nodes: node {t} has no free translation (a clamped node cannot be a contact "
+                                "node)")
     return tips, rows
+
+
+def tip_values(V: np.ndarray, tip_rows: np.ndarray) -> np.ndarray:
+    """(n_t, 3, m) tip displacements of the columns of V (file axes); zero along constrained translations."""
+    out = V[np.clip(tip_rows, 0, None)]
+    out[tip_rows < 0] = 0.0
+    return out
+
+
+def tip_flexibility(f0, K0, V: np.ndarray, tip_rows: np.ndarray) -> np.ndarray:
+    """The tip's residual flexibility (3 n_t square, file axes), zero along constrained translations."""
+    flat = tip_rows.reshape(-1)
+    ok = np.flatnonzero(flat >= 0)
+    G = np.zeros((flat.size, flat.size))
+    G[np.ix_(ok, ok)] = residual_flexibility(f0, K0, V, flat[ok])
+    return G
 
 
 def _check_clamped(fe: FEModel, frame: BladeFrame, R_free: np.ndarray) -> None:
@@ -355,13 +371,13 @@ def tip_normalised_modes(fe: FEModel, V: np.ndarray, tip_rows: np.ndarray) -> np
     M = fe.M_free
     _, z = eigh(V.T @ (fe.K0 @ V), V.T @ (M @ V))
     V = V @ z
-    nt = tip_rows.shape[0]
-    tipdisp = np.linalg.norm(V[tip_rows.reshape(-1)].reshape(nt, 3, -1), axis=1)
+    tv = tip_values(V, tip_rows)
+    tipdisp = np.linalg.norm(tv, axis=1)
     imax = np.argmax(tipdisp, axis=0)
     scale = tipdisp[imax, np.arange(V.shape[1])]
     if np.any(scale < 1e-9 * np.abs(V).max(axis=0)):
         raise FEImportError("tip_nodes: a kept mode does not move the tip nodes (are they on the blade?)")
-    comp = np.array([V[tip_rows[imax[k]], k] for k in range(V.shape[1])])  # (m, 3)
+    comp = tv[imax, :, np.arange(V.shape[1])]  # (m, 3)
     sign = np.sign(comp[np.arange(V.shape[1]), np.argmax(np.abs(comp), axis=1)])
     return V * (sign / scale)
 
@@ -416,18 +432,16 @@ def assemble_superelement(fe: FEModel, frame: BladeFrame, V: np.ndarray, tips: n
         # or there is no K(Omega) at all (order 0: the stress stiffening is then neglected), it is added here
         K1r = K1r + basis_softening[6:, 6:]
     nt = tips.size
-    flat = tip_rows.reshape(-1)
     tip_positions = frame.to_blade(fe.coordinates_of(tips))
-    tip_recovery = np.einsum("ab,ibm->iam", Q, V[flat].reshape(nt, 3, m))
+    tip_recovery = np.einsum("ab,ibm->iam", Q, tip_values(V, tip_rows))
     tip_residual = np.zeros((3 * nt, 3 * nt))
     tip_centrifugal = np.zeros((nt, 3))
     if f0 is not None:
-        Gf = residual_flexibility(f0, fe.K0, V, flat)
         Qb = np.kron(np.eye(nt), Q)
-        tip_residual = Qb @ Gf @ Qb.T
+        tip_residual = Qb @ tip_flexibility(f0, fe.K0, V, tip_rows) @ Qb.T
         # centrifugal load per Omega^2: int rho P x on the free rows (the other rows are reactions)
         u_cf = f0.solve((M_all @ (Pn @ x_field))[free_idx])
-        tip_centrifugal = np.einsum("ab,ib->ia", Q, u_cf[tip_rows])
+        tip_centrifugal = np.einsum("ab,ib->ia", Q, tip_values(u_cf[:, None], tip_rows)[:, :, 0])
     return ReducedBlade(
         K0=K0r, K1=K1r, K2=K2r, damping_ratio=float(damping_ratio), basis_mass=0.5 * (basis_mass + basis_mass.T),
         basis_coriolis=0.5 * (basis_coriolis - basis_coriolis.T), basis_softening=basis_softening,
