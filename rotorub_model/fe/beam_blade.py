@@ -74,9 +74,10 @@ def beam_matrices(p: Parameters, s: np.ndarray, omega: float) -> sp.csr_matrix:
 
 
 def write_beam_blade(p: Parameters, folder: str | Path, speeds: tuple[float, ...] = (0.0,),
-                     n_elements: int = 120, layout: str = "uniform") -> dict:
+                     n_elements: int = 120, layout: str = "uniform", spin_softening: bool = True) -> dict:
     """Write the beam blade of ``p`` (SI): ``mass.mtx`` on ``mass_dofs.txt``, ``stiffness_{k}.mtx`` at
-    ``speeds[k]`` [rad/s] on ``dofs.txt``, ``nodes.txt``; returns the paths, speeds, the spin axis (file axes)
+    ``speeds[k]`` [rad/s] on ``dofs.txt``, ``nodes.txt`` (``spin_softening``: K(Omega) holds -Omega^2 M P, as
+    CalculiX's does, or not, as some codes' do not); returns the paths, speeds, the spin axis (file axes)
     and the tip node id."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
@@ -96,7 +97,7 @@ def write_beam_blade(p: Parameters, folder: str | Path, speeds: tuple[float, ...
     free = np.arange(2, 2 * nn)  # (v, v') of nodes 2..nn in the element ordering
     (folder / "dofs.txt").write_text("".join(f"{i}.{c}\n" for i in ids[1:] for c in (2, 6)))
     soft = np.zeros(2 * nn)
-    soft[0::2] = np.cos(beta) ** 2 * m
+    soft[0::2] = np.cos(beta) ** 2 * m if spin_softening else 0.0
     files = []
     for k, w in enumerate(speeds):
         K = beam_matrices(p, s, w) - w * w * sp.diags(soft)

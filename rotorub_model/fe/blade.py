@@ -183,7 +183,11 @@ def load_superelement(path: str | Path) -> ReducedBlade:
         A = a[k]
         if np.abs(A - A.T).max() > 1e-8 * np.abs(A).max():
             raise FEImportError(f"superelement: {path}: {k} is not symmetric")
-        if np.linalg.eigvalsh(0.5 * (A + A.T)).min() <= 0:
+        # K0 and the blade's own mass positive definite; the rigid block may be singular (a line of point masses
+        # has no inertia about its own axis)
+        lam = np.linalg.eigvalsh(0.5 * (A + A.T))
+        B = A if k == "K0" else A[6:, 6:]
+        if np.linalg.eigvalsh(0.5 * (B + B.T)).min() <= 0 or lam.min() < -1e-10 * lam.max():
             raise FEImportError(f"superelement: {path}: {k} is not positive definite"
                                 + (" (the blade has rigid-body modes: is the root clamped?)" if k == "K0" else ""))
     if np.unique(a["tip_nodes"]).size != nt or nt == 0:
