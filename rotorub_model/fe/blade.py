@@ -59,6 +59,7 @@ from .rotating import (
 from .units import unit_system
 
 FORMAT = "rotorub-superelement-1"
+BASES = ("condensed", "modal", "two-speed")
 ARRAY_FIELDS = ("K0", "K1", "K2", "basis_mass", "basis_coriolis", "basis_softening", "basis_euler",
                 "basis_euler_load", "second_moments", "centrifugal_coupling", "euler_coupling", "tip_nodes",
                 "tip_positions", "tip_recovery", "tip_residual", "tip_centrifugal", "nodes", "speeds")
@@ -280,21 +281,25 @@ def _rows_xyz(fe: FEModel, nodes: np.ndarray) -> np.ndarray:
     return fe.coordinates[[node_index[int(k)] for k in nodes]]
 
 
-def reduce_blade(fe: FEModel, tip_nodes, *, cutoff_hz: float = 1000.0, basis: str = "modal", order: int | None = None,
-                 damping_ratio: float = 0.005, axis_origin=(0.0, 0.0, 0.0), axis_direction=(0.0, 0.0, 1.0),
+def reduce_blade(fe: FEModel, tip_nodes, *, cutoff_hz: float = 1500.0, basis: str = "condensed",
+                 order: int | None = None, damping_ratio: float = 0.005, axis_origin=(0.0, 0.0, 0.0),
+                 axis_direction=(0.0, 0.0, 1.0),
                  radial_direction=None, reference_speeds: bool = True, name: str = "") -> ReducedBlade:
     """Reduce ``fe`` (root clamped) to a :class:`ReducedBlade`.
 
-    ``cutoff_hz``: keep the fixed-interface modes below it (at least one); ``basis``: 'modal' (modes at rest)
-    or 'two-speed' (modes at rest and at the highest speed of the FE data); ``order``: 2 for K0 + W^2 K1 +
-    W^4 K2 (needs 3 speeds), 1 for K0 + W^2 K1 (2 speeds), 0 for the rest stiffness alone (the stress
-    stiffening is then neglected); default: the highest the speeds allow. ``axis_origin``: a point of the
+    ``cutoff_hz``: keep the fixed-interface modes below it (at least one); ``basis``: 'condensed' (the modes
+    at rest carry the mass; what the modes at the highest speed of the FE data add to them is condensed
+    statically into K(Omega), massless: the default, see :mod:`rotorub_model.fe.reduction`), 'modal'
+    (the modes at rest alone) or 'two-speed' (modes at rest and at the top speed, all with their mass:
+    the built-in blades' choice, exact at both speeds, but the added directions can be stiff); ``order``:
+    2 for K0 + W^2 K1 + W^4 K2 (needs 3 speeds), 1 for K0 + W^2 K1 (2 speeds), 0 for the rest stiffness alone
+    (the stress stiffening is then neglected); default: the highest the speeds allow. ``axis_origin``: a point of the
     spin axis at the fan disk's station, in the file's length unit; ``axis_direction``: the spin axis (file
     axes, spin positive about it); ``radial_direction``: default through the blade's centre of mass.
     ``reference_speeds``: also solve the full model at every speed (the check of the reduction)."""
     t_start = time.perf_counter()
-    if basis not in ("modal", "two-speed"):
-        raise FEImportError(f"basis: {basis!r}; accepted: 'modal' or 'two-speed'")
+    if basis not in BASES:
+        raise FEImportError(f"basis: {basis!r}; accepted: {', '.join(repr(b) for b in BASES)}")
     if not (np.isfinite(cutoff_hz) and cutoff_hz > 0):
         raise FEImportError(f"cutoff_hz: {cutoff_hz!r}; accepted: a frequency > 0 Hz")
     if not (0.0 <= damping_ratio <= 0.5):
@@ -313,12 +318,16 @@ def reduce_blade(fe: FEModel, tip_nodes, *, cutoff_hz: float = 1000.0, basis: st
     w0, P0 = lowest_modes(fe.K0, M, f0, cutoff_hz)
     t_rest = time.perf_counter() - t0
     top = None
-    if speeds.size > 1 and (basis == "two-speed" or reference_speeds):
+    if speeds.size > 1 and (basis != "modal" or reference_speeds):
         ft = factorize(fe.stiffness[-1][1], f"{fe.source}: stiffness at {speeds[-1]:.4g} rad/s")
         top = lowest_modes(fe.stiffness[-1][1], M, ft, cutoff_hz, at_least=min(w0.size, fe.n_dofs - 2))
-    V = P0 if basis == "modal" or top is None else orthonormal_basis([P0, top[1]], M)
+    V = orthonormal_basis([P0, top[1]], M) if basis == "two-speed" and top is not None else P0
     V = tip_normalised_modes(fe, V, tip_rows)
-    blade = assemble_superelement(fe, frame, V, tips, tip_rows, order, soft, damping_ratio, f0)
+    Kr = None
+    if basis == "condensed" and top is not None:
+        Cm = complement(top[1], V, M)
+        Kr = [condensed(V, Cm, K) for _, K in fe.stiffness]
+    blade = assemble_superelement(fe, frame, V, tips, tip_rows, order, soft, damping_ratio, f0, Kr=Kr)
     reference: dict = {"full_rest_hz": w0 / TWO_PI}
     if reference_speeds and speeds.size > 1:
         for k, (w, K) in enumerate(fe.stiffness[1:], start=1):
@@ -386,14 +395,31 @@ def tip_normalised_modes(fe: FEModel, V: np.ndarray, tip_rows: np.ndarray) -> np
     return V * (sign / scale)
 
 
+def complement(P: np.ndarray, V: np.ndarray, M) -> np.ndarray:
+    """An M-orthonormal basis of what the columns of P add to span(V) (V M-orthogonal columns)."""
+    MV = M @ V
+    C = P - V @ np.linalg.solve(V.T @ MV, MV.T @ P)
+    C = C / np.sqrt(np.einsum("ij,ij->j", C, M @ C))  # scale first: the added parts are small in mass
+    return orthonormal_basis([C], M, tol=1e-10)
+
+
+def condensed(V: np.ndarray, C: np.ndarray, K) -> np.ndarray:
+    """K on span(V) with the directions C condensed statically (massless): K_VV - K_VC K_CC^-1 K_CV."""
+    KV, KC = K @ V, K @ C
+    Kvc = V.T @ KC
+    return V.T @ KV - Kvc @ np.linalg.solve(C.T @ KC, Kvc.T)
+
+
 def assemble_superelement(fe: FEModel, frame: BladeFrame, V: np.ndarray, tips: np.ndarray, tip_rows: np.ndarray,
-                          order: int, soft: bool | None, damping_ratio: float, f0=None) -> ReducedBlade:
+                          order: int, soft: bool | None, damping_ratio: float, f0=None,
+                          Kr: list[np.ndarray] | None = None) -> ReducedBlade:
     """The :class:`ReducedBlade` of the basis V (free dofs, any scaling): reduced speed terms, the rigid-body
     kernels and the tip quantities (``f0``: a factorization of K0, for the tip's residual flexibility and
     centrifugal displacement; without it they are left zero)."""
     speeds = fe.speeds
     m = V.shape[1]
-    Kr = [V.T @ (K @ V) for _, K in fe.stiffness]
+    if Kr is None:  # the stiffness at each speed on V (given: condensed)
+        Kr = [V.T @ (K @ V) for _, K in fe.stiffness]
     terms = identify_speed_terms(speeds, Kr, order) if order else [Kr[0]]
     K0r = terms[0]
     K1r = terms[1] if order >= 1 else np.zeros((m, m))
