@@ -284,7 +284,8 @@ def _rows_xyz(fe: FEModel, nodes: np.ndarray) -> np.ndarray:
 def reduce_blade(fe: FEModel, tip_nodes, *, cutoff_hz: float = 1500.0, basis: str = "condensed",
                  order: int | None = None, damping_ratio: float = 0.005, axis_origin=(0.0, 0.0, 0.0),
                  axis_direction=(0.0, 0.0, 1.0),
-                 radial_direction=None, reference_speeds: bool = True, name: str = "") -> ReducedBlade:
+                 radial_direction=None, reference_speeds: bool = True, name: str = "",
+                 diagnostics: dict | None = None) -> ReducedBlade:
     """Reduce ``fe`` (root clamped) to a :class:`ReducedBlade`.
 
     ``cutoff_hz``: keep the fixed-interface modes below it (at least one); ``basis``: 'condensed' (the modes
@@ -296,7 +297,8 @@ def reduce_blade(fe: FEModel, tip_nodes, *, cutoff_hz: float = 1500.0, basis: st
     (the stress stiffening is then neglected); default: the highest the speeds allow. ``axis_origin``: a point of the
     spin axis at the fan disk's station, in the file's length unit; ``axis_direction``: the spin axis (file
     axes, spin positive about it); ``radial_direction``: default through the blade's centre of mass.
-    ``reference_speeds``: also solve the full model at every speed (the check of the reduction)."""
+    ``reference_speeds``: also solve the full model at every speed (the check of the reduction).
+    ``diagnostics``: a dict to receive the full model's modes, factorizations, basis and frame (the report's)."""
     t_start = time.perf_counter()
     if basis not in BASES:
         raise FEImportError(f"basis: {basis!r}; accepted: {', '.join(repr(b) for b in BASES)}")
@@ -323,10 +325,12 @@ def reduce_blade(fe: FEModel, tip_nodes, *, cutoff_hz: float = 1500.0, basis: st
         top = lowest_modes(fe.stiffness[-1][1], M, ft, cutoff_hz, at_least=min(w0.size, fe.n_dofs - 2))
     V = orthonormal_basis([P0, top[1]], M) if basis == "two-speed" and top is not None else P0
     V = tip_normalised_modes(fe, V, tip_rows)
-    Kr = None
+    Kr = Cm = None
     if basis == "condensed" and top is not None:
         Cm = complement(top[1], V, M)
         Kr = [condensed(V, Cm, K) for _, K in fe.stiffness]
+    if diagnostics is not None:
+        diagnostics.update(rest=(w0, P0), top=top, factor0=f0, V=V, complement=Cm, frame=frame, tip_rows=tip_rows)
     blade = assemble_superelement(fe, frame, V, tips, tip_rows, order, soft, damping_ratio, f0, Kr=Kr)
     reference: dict = {"full_rest_hz": w0 / TWO_PI}
     if reference_speeds and speeds.size > 1:
