@@ -8,7 +8,8 @@ chord's angle from the spin axis) twisting from 25 deg at the root to 45 deg at 
 against 25.0).
 
 Everything is written in N-mm-t-s, as an FE engineer's deck usually is. Quadratic tetrahedra (C3D10); the
-root face is clamped (*BOUNDARY on every node at r = 400 mm); the tip nodes are every node of the tip face.
+root face is clamped (*BOUNDARY on every node at r = 400 mm); the contact (tip) nodes are the nodes on the
+tip face's two long edges, from the leading to the trailing edge (``tip_nodes.txt``).
 One CalculiX job a speed: at rest, a *FREQUENCY step; at speed, a *STATIC step under the centrifugal load
 (CENTRIF about the z axis) then *FREQUENCY steps with PERTURBATION: their stiffness holds the stress
 stiffening, the spin softening and the initial-displacement stiffness of the static deflection, so it is
@@ -96,7 +97,13 @@ def mesh(out: Path, mesh_size: float) -> Path:
     nodes = np.array([[float(v) for v in s.split(",")] for s in keep[1:keep.index(
         "*ELEMENT, TYPE=C3D10, ELSET=EALL")]])
     root = nodes[np.abs(nodes[:, 1] - HUB) < 1e-6, 0].astype(int)
-    tip = nodes[np.abs(nodes[:, 1] - TIP) < 1e-6, 0].astype(int)
+    face = nodes[np.abs(nodes[:, 1] - TIP) < 1e-6]
+    # the contact nodes: the tip face's two long edges (pressure and suction side), leading to trailing edge
+    b = np.radians(STAGGER[1])
+    d = face[:, 2] * np.cos(b) + face[:, 3] * np.sin(b)  # across the thickness
+    along = -face[:, 2] * np.sin(b) + face[:, 3] * np.cos(b)  # along the chord
+    edge = np.abs(np.abs(d) - 0.5 * THICK[1]) < 1e-3
+    tip = face[edge][np.lexsort((d[edge], along[edge])), 0].astype(int)
     text = "\n".join(keep) + "\n*NSET, NSET=ROOT\n" + "".join(f"{k},\n" for k in root)
     text += "*NSET, NSET=TIP\n" + "".join(f"{k},\n" for k in tip)
     (out / "mesh.inp").write_text(text)

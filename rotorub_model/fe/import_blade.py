@@ -238,8 +238,7 @@ def run_import_blade(fe: FEModel | ReducedBlade, tip_nodes=None, *, cutoff_hz: f
         for k in range(1, blade.m + 1):
             Vk = V[:, :k]
             Kk = condensed(Vk, C, Ktop) if C is not None else Vk.T @ (Ktop @ Vk)
-            fk = np.sqrt(np.clip(np.linalg.eigvalsh(np.linalg.solve(Vk.T @ (M @ Vk), Kk)), 0, None)) / TWO_PI
-            fk = np.sort(fk)
+            fk = _modes(0.5 * (Kk + Kk.T), Vk.T @ (M @ Vk))[0] / TWO_PI
             j = min(3, k)
             conv[k] = float(np.max(np.abs(fk[:j] / wt[:j] - 1.0)))
     # the step of the kept blade: at the top speed, contact through the tip's massless residual flexibility
