@@ -38,9 +38,9 @@ def test_kept_example_matches_calculix():
 
 def test_example_in_the_bladed_disk():
     """Ten example blades on the reference rotor: a pure translation of the fan disk carries the ten blades'
-    mass, the matrices are symmetric (M, K, D, N2, S2) and antisymmetric (G1), M positive definite, and every
-    tip node lies in the tip plane at the reference tip radius and follows the disk's translation; with the shaft, M is positive
-    definite."""
+    mass, the matrices are symmetric (M, K, D, N2, S2) and antisymmetric (G1), with the shaft's M positive
+    definite, and every tip node lies in the tip plane at the reference tip radius and follows the disk's
+    translation."""
     p = reference_parameters()
     blade = load_superelement(COARSE / "blade.npz")
     mats = fe_bladed_disk_matrices(p, blade)
