@@ -268,10 +268,15 @@ def _check_clamped(fe: FEModel, frame: BladeFrame, R_free: np.ndarray) -> None:
 def _frame_of(fe: FEModel, axis_origin, axis_direction, radial_direction) -> BladeFrame:
     L = unit_system(fe.units).length
     node_index = {int(k): i for i, k in enumerate(fe.node_ids)}
-    ex = np.where(fe.mass_components == 1, 1.0, 0.0)
-    mrow = np.asarray(fe.M @ ex) * ex  # the nodal mass (translation along the file's x) locates the centre of mass
+    # the nodal masses locate the centre of mass: a node's mass in each translation it has, averaged
     masses = np.zeros(fe.node_ids.size)
-    np.add.at(masses, [node_index[int(k)] for k in fe.mass_nodes], mrow)
+    counts = np.zeros(fe.node_ids.size)
+    where = np.array([node_index[int(k)] for k in fe.mass_nodes])
+    for c in (1, 2, 3):
+        e = np.where(fe.mass_components == c, 1.0, 0.0)
+        np.add.at(masses, where, np.asarray(fe.M @ e) * e)
+        np.add.at(counts, where, e)
+    masses = masses / np.maximum(counts, 1.0)
     return blade_frame(fe.coordinates, masses, np.asarray(axis_origin, dtype=float) * L, axis_direction,
                        radial_direction)
 

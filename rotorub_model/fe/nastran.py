@@ -51,12 +51,14 @@ def read_dmig(punch: str | Path, mass: str, stiffness: list[str], coordinates: s
         raise FEImportError(f"dmig: {len(stiffness)} stiffness matrices need as many speeds")
     names = [mass, *stiffness]
     try:
-        dct = bulk.rddmig(str(punch), names, square=True)
+        dct = bulk.rddmig(str(punch), square=True)
     except Exception as exc:  # pyyeti raises plain exceptions on malformed cards
         raise FEImportError(f"{punch}: DMIG entries cannot be read ({exc})") from None
+    low = {k.lower(): v for k, v in dct.items()}  # NASTRAN names are case-blind (pyyeti lower-cases them)
     for nm in names:
-        if nm not in dct:
+        if nm.lower() not in low:
             raise FEImportError(f"{punch}: no DMIG named {nm!r}; found: {', '.join(sorted(dct)) or 'none'}")
+    dct = {nm: low[nm.lower()] for nm in names}
     ref = dct[stiffness[0]].index
     nodes = np.array([int(a) for a, _ in ref], dtype=np.int64)
     comps = np.array([int(b) for _, b in ref], dtype=np.int64)
@@ -73,7 +75,9 @@ def read_dmig(punch: str | Path, mass: str, stiffness: list[str], coordinates: s
         return sp.csr_matrix(df.to_numpy(dtype=float))
 
     Mdf = dct[mass]
-    mindex = Mdf.index
+    # a DMIG lists its non-zero terms only: a massless dof (a beam's rotation) has no row; the mass is read on
+    # the stiffness' dofs and its own extra ones (the constrained, rigidly moving rows)
+    mindex = ref.append(Mdf.index.difference(ref, sort=False))
     mnodes = np.array([int(a) for a, _ in mindex], dtype=np.int64)
     mcomps = np.array([int(b) for _, b in mindex], dtype=np.int64)
     M = matrix(mass, mindex)
