@@ -324,19 +324,29 @@ def reduce_blade(fe: FEModel, tip_nodes, *, cutoff_hz: float = 1500.0, basis: st
     f0 = factorize(fe.K0, f"{fe.source}: stiffness at rest")
     w0, P0 = lowest_modes(fe.K0, M, f0, cutoff_hz)
     t_rest = time.perf_counter() - t0
+    statics = None
+    if basis != "two-speed":
+        # the tip's statics need K0's factorization and the final basis, known now: then it can go before
+        # K(Omega_top)'s is made (the two together are most of the peak memory)
+        V = tip_normalised_modes(fe, P0, tip_rows)
+        statics = tip_statics(fe, frame, V, tip_rows, f0)
+        if diagnostics is None:
+            f0 = None
     top = None
     if speeds.size > 1 and (basis != "modal" or reference_speeds):
         ft = factorize(fe.stiffness[-1][1], f"{fe.source}: stiffness at {speeds[-1]:.4g} rad/s")
         top = lowest_modes(fe.stiffness[-1][1], M, ft, cutoff_hz, at_least=min(w0.size, fe.n_dofs - 2))
-    V = orthonormal_basis([P0, top[1]], M) if basis == "two-speed" and top is not None else P0
-    V = tip_normalised_modes(fe, V, tip_rows)
+    if basis == "two-speed":
+        V = orthonormal_basis([P0, top[1]], M) if top is not None else P0
+        V = tip_normalised_modes(fe, V, tip_rows)
     Kr = Cm = None
     if basis == "condensed" and top is not None:
         Cm = complement(top[1], V, M)
         Kr = [condensed(V, Cm, K) for _, K in fe.stiffness]
     if diagnostics is not None:
         diagnostics.update(rest=(w0, P0), top=top, factor0=f0, V=V, complement=Cm, frame=frame, tip_rows=tip_rows)
-    blade = assemble_superelement(fe, frame, V, tips, tip_rows, order, soft, damping_ratio, f0, Kr=Kr)
+    blade = assemble_superelement(fe, frame, V, tips, tip_rows, order, soft, damping_ratio, f0, Kr=Kr,
+                                  statics=statics)
     reference: dict = {"full_rest_hz": w0 / TWO_PI}
     if reference_speeds and speeds.size > 1:
         for k, (w, K) in enumerate(fe.stiffness[1:], start=1):
@@ -419,9 +429,20 @@ def condensed(V: np.ndarray, C: np.ndarray, K) -> np.ndarray:
     return V.T @ KV - Kvc @ np.linalg.solve(C.T @ KC, Kvc.T)
 
 
+def tip_statics(fe: FEModel, frame: BladeFrame, V: np.ndarray, tip_rows: np.ndarray, f0) -> tuple:
+    """(the tip's residual flexibility (3 n_t square, file axes), the static displacement of the free dofs
+    under the centrifugal load per Omega^2: int rho P x on the free rows, the others being reactions)."""
+    mnodes, mcomps = fe.mass_nodes, fe.mass_components
+    node_index = {int(k): i for i, k in enumerate(fe.node_ids)}
+    _, Pn = frame_operators(frame, mnodes, mcomps)
+    x_field = nodal_field(fe.coordinates - frame.origin, mnodes, mcomps, node_index)
+    u_cf = f0.solve(np.asarray(fe.M @ (Pn @ x_field))[fe.free_in_mass()])
+    return tip_flexibility(f0, fe.K0, V, tip_rows), u_cf
+
+
 def assemble_superelement(fe: FEModel, frame: BladeFrame, V: np.ndarray, tips: np.ndarray, tip_rows: np.ndarray,
                           order: int, soft: bool | None, damping_ratio: float, f0=None,
-                          Kr: list[np.ndarray] | None = None) -> ReducedBlade:
+                          Kr: list[np.ndarray] | None = None, statics: tuple | None = None) -> ReducedBlade:
     """The :class:`ReducedBlade` of the basis V (free dofs, any scaling): reduced speed terms, the rigid-body
     kernels and the tip quantities (``f0``: a factorization of K0, for the tip's residual flexibility and
     centrifugal displacement; without it they are left zero)."""
@@ -475,11 +496,12 @@ def assemble_superelement(fe: FEModel, frame: BladeFrame, V: np.ndarray, tips: n
     tip_recovery = np.einsum("ab,ibm->iam", Q, tip_values(V, tip_rows))
     tip_residual = np.zeros((3 * nt, 3 * nt))
     tip_centrifugal = np.zeros((nt, 3))
-    if f0 is not None:
+    if statics is None and f0 is not None:
+        statics = tip_statics(fe, frame, V, tip_rows, f0)
+    if statics is not None:
+        Gf, u_cf = statics
         Qb = np.kron(np.eye(nt), Q)
-        tip_residual = Qb @ tip_flexibility(f0, fe.K0, V, tip_rows) @ Qb.T
-        # centrifugal load per Omega^2: int rho P x on the free rows (the other rows are reactions)
-        u_cf = f0.solve((M_all @ (Pn @ x_field))[free_idx])
+        tip_residual = Qb @ Gf @ Qb.T
         tip_centrifugal = np.einsum("ab,ib->ia", Q, tip_values(u_cf[:, None], tip_rows)[:, :, 0])
     return ReducedBlade(
         K0=K0r, K1=K1r, K2=K2r, damping_ratio=float(damping_ratio), basis_mass=0.5 * (basis_mass + basis_mass.T),

@@ -85,19 +85,28 @@ def lowest_modes(K: sp.spmatrix, M: sp.spmatrix, factor: Factor, cutoff_hz: floa
     """(omega [rad/s], Phi M-orthonormal) of every mode below ``cutoff_hz`` (at least ``at_least``), by
     shift-invert Lanczos about 0 with the given factorization."""
     n = K.shape[0]
-    k = min(max(at_least, 8), n - 2)
+    # massless dofs (a beam's rotations with lumped masses) carry no mode: the Lanczos space stays below their count
+    n_eff = min(n, int(np.count_nonzero(M.diagonal())))
+    top = max(1, min(at_most, n_eff - 2, n - 2))
+    k = min(max(at_least, 24), top)  # one Lanczos run for the usual cut-offs (each restart costs one)
     op = factor.operator()
     while True:
-        lam, V = sla.eigsh(K, k=k, M=M, sigma=0.0, OPinv=op, which="LM", tol=1e-12)
+        try:
+            lam, V = sla.eigsh(K, k=k, M=M, sigma=0.0, OPinv=op, which="LM", tol=1e-10,
+                               ncv=min(n_eff, max(2 * k + 1, 20)))
+        except (sla.ArpackError, sla.ArpackNoConvergence) as exc:
+            raise FEImportError(f"eigenvalues: the Lanczos iteration failed ({str(exc).splitlines()[0][:120]}): "
+                                "is the mass matrix positive semi-definite, with mass on the blade's "
+                                "translations?") from None
         order = np.argsort(lam)
         lam, V = lam[order], V[:, order]
         if lam[0] <= 0:
             raise FEImportError(f"eigenvalues: {lam[0]:.3g} (rad/s)^2 <= 0: mass or stiffness is not positive "
                                 "definite (a negative or zero mass, or rigid-body modes)")
         w = np.sqrt(lam)
-        if w[-1] > TWO_PI * cutoff_hz or k >= min(at_most, n - 2):
+        if w[-1] > TWO_PI * cutoff_hz or k >= top:
             break
-        k = min(2 * k, at_most, n - 2)
+        k = min(2 * k, top)
     keep = max(at_least, int(np.sum(w <= TWO_PI * cutoff_hz)))
     return w[:keep], V[:, :keep]
 
