@@ -336,6 +336,7 @@ def reduce_blade(fe: FEModel, tip_nodes, *, cutoff_hz: float = 1500.0, basis: st
     if speeds.size > 1 and (basis != "modal" or reference_speeds):
         ft = factorize(fe.stiffness[-1][1], f"{fe.source}: stiffness at {speeds[-1]:.4g} rad/s")
         top = lowest_modes(fe.stiffness[-1][1], M, ft, cutoff_hz, at_least=min(w0.size, fe.n_dofs - 2))
+        del ft  # one factorization alive at a time (the peak memory)
     if basis == "two-speed":
         V = orthonormal_basis([P0, top[1]], M) if top is not None else P0
         V = tip_normalised_modes(fe, V, tip_rows)

@@ -22,6 +22,7 @@ from .femodel import FEModel
 from .reduction import TWO_PI, compare_reductions, contact_stiffness, explicit_step, mac
 
 CALCULIX_SUFFIXES = (".sti", ".mas", ".dof", ".inp", "")
+VARIANTS_MAX_DOFS = 20000  # above, the comparison of reductions costs more than the import: asked for only
 
 
 def read_tip_nodes(spec) -> np.ndarray:
@@ -203,11 +204,15 @@ class ImportBladeResult:
 
 def run_import_blade(fe: FEModel | ReducedBlade, tip_nodes=None, *, cutoff_hz: float = 1500.0,
                      basis: str = "condensed", k_r: float = 1.5e6, own_hz: list[np.ndarray] | None = None,
-                     n_compare: int = 8, variants: bool = True, **kw) -> ImportBladeResult:
+                     n_compare: int = 8, variants: bool | None = None, **kw) -> ImportBladeResult:
     """Reduce ``fe`` and measure: frequencies at every speed against the full model (and the FE code's own),
     MAC, convergence with the number of modes, the explicit step of each reduction (contact k_r [N/m] spread
-    over the tip nodes, radially). ``kw``: the other arguments of :func:`reduce_blade`."""
+    over the tip nodes, radially; ``variants``: default for models up to VARIANTS_MAX_DOFS dofs: the
+    comparison factorizes the blade with its tip fixed and builds Craig-Bampton's hundreds of constraint
+    modes). ``kw``: the other arguments of :func:`reduce_blade`."""
     t0 = time.perf_counter()
+    if variants is None:
+        variants = fe.n_dofs <= VARIANTS_MAX_DOFS
     diag: dict = {}
     if isinstance(fe, ReducedBlade):
         raise FEImportError("import-blade: a superelement is already reduced; load it with load_superelement")
@@ -259,6 +264,9 @@ def run_import_blade(fe: FEModel | ReducedBlade, tip_nodes=None, *, cutoff_hz: f
         var = [v.as_dict() for v in vs]
     t_var = time.perf_counter() - t1
     notes = []
+    if not var:
+        notes.append(f"the reductions were not compared ({fe.n_dofs} dofs > {VARIANTS_MAX_DOFS}, or one speed, or "
+                     "constrained tip translations): --compare-reductions to force it")
     if speeds.size < 2:
         notes.append("one stiffness only: the stress stiffening is neglected (spin softening from M is in)")
     return ImportBladeResult(blade=blade, speeds=speeds, full_hz=full, own_hz=own_hz, reduced_hz=red,
