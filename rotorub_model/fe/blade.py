@@ -330,7 +330,7 @@ def reduce_blade(fe: FEModel, tip_nodes, *, cutoff_hz: float = 1500.0, basis: st
         # K(Omega_top)'s is made (the two together are most of the peak memory)
         V = tip_normalised_modes(fe, P0, tip_rows)
         statics = tip_statics(fe, frame, V, tip_rows, f0)
-        if diagnostics is None:
+        if diagnostics is None or not diagnostics.get("keep_factor", True):
             f0 = None
     top = None
     if speeds.size > 1 and (basis != "modal" or reference_speeds):

@@ -145,21 +145,35 @@ class ImportBladeResult:
     def figure(self):
         plt = pyplot()
         b = self.blade
-        fig, ax = plt.subplots(2, 2, figsize=(12, 8.5))
+        fig = plt.figure(figsize=(15, 8.5))
+        gs = fig.add_gridspec(2, 3)
         x = b.nodes
         step = max(1, x.shape[0] // 20000)
-        for a, (i, j, lab) in zip(ax[0], ((0, 2, "axial z [m]"), (1, 2, "axial z [m]"))):
+        for k, (i, j) in enumerate(((0, 2), (1, 2))):
+            a = fig.add_subplot(gs[0, k])
             a.plot(x[::step, i], x[::step, j], ",", color="0.55")
             a.plot(b.tip_positions[:, i], b.tip_positions[:, j], "o", ms=3.5, color="tab:red",
                    label=f"tip nodes ({len(b.tip_nodes)})")
             a.set_xlabel(("radial x", "tangential y (spin direction)")[i] + " [m]")
-            a.set_ylabel(lab)
+            a.set_ylabel("axial z [m]")
             a.set_aspect("equal", adjustable="datalim")
             a.grid(alpha=0.3)
-        ax[0, 0].set_title("mesh, blade frame: side view")
-        ax[0, 1].set_title("mesh seen down the span (twist)")
-        ax[0, 0].legend(loc="best", fontsize=8)
-        a = ax[1, 0]
+            a.set_title(("mesh, blade frame: side view", "mesh seen down the span (twist)")[k])
+            if k == 0:
+                a.legend(loc="best", fontsize=8)
+        a = fig.add_subplot(gs[0, 2])
+        if self.convergence:
+            ks = np.array(sorted(int(k) for k in self.convergence))
+            a.semilogy(ks, [max(self.convergence[k], 1e-16) for k in ks], "o-", color="tab:blue")
+            a.set_xlabel("modes at rest kept (the top speed's additions condensed)")
+            a.set_ylabel("worst error, first three frequencies")
+            a.set_title(f"convergence at the top speed ({self.speeds.max():.4g} rad/s)")
+            a.grid(alpha=0.3, which="both")
+        else:
+            a.text(0.5, 0.5, "one speed: no convergence at speed to show", ha="center", va="center",
+                   transform=a.transAxes, color="0.35")
+            a.set_axis_off()
+        a = fig.add_subplot(gs[1, :2])
         w = np.linspace(0.0, self.speeds.max(), 60)
         curves = np.array([b.frequencies(float(v))[:self.n_compare] for v in w])
         a.plot(w, curves, color="tab:blue", lw=1.0)
@@ -173,22 +187,28 @@ class ImportBladeResult:
         a.plot([], [], color="tab:blue", label=f"reduced ({b.m} dofs), K(Ω) identified")
         a.set_xlabel("spin speed Ω [rad/s]")
         a.set_ylabel("clamped blade frequency [Hz]")
-        a.set_title(f"frequencies against speed (worst error {100 * self.errors().max():.2g} %)")
+        a.set_title(f"frequencies against speed (worst error {100 * self.errors().max():.2g} %); explicit step "
+                    f"{1e3 * self.step['step']:.3g} ms ({self.step['f_max_hz']:.4g} Hz at the top speed)")
         a.legend(fontsize=8)
         a.grid(alpha=0.3)
-        a = ax[1, 1]
-        names = [v["name"] for v in self.variants]
-        steps = [1e3 * v["step"] for v in self.variants]
-        colors = ["tab:green" if n == "condensed+massless-boundary" else "tab:gray" for n in names]
-        a.barh(names, steps, color=colors)
-        a.set_xscale("log")
-        for k, v in enumerate(self.variants):
-            a.text(steps[k], k, f" {v['dofs']} dofs, top-speed error {100 * v['freq_error_top']:.2g} %",
-                   va="center", fontsize=7)
-        a.set_xlabel("explicit step 2/ω_max with contact, at the top speed [ms] (log)")
-        a.set_title("what each reduction allows (green: the one kept)")
-        a.grid(alpha=0.3, axis="x")
-        fig.suptitle(f"Imported blade: {b.info.get('source', '')}", fontsize=11)
+        a = fig.add_subplot(gs[1, 2])
+        if self.variants:
+            names = [v["name"] for v in self.variants]
+            steps = [1e3 * v["step"] for v in self.variants]
+            colors = ["tab:green" if n == "condensed+massless-boundary" else "tab:gray" for n in names]
+            a.barh(names, steps, color=colors)
+            a.set_xscale("log")
+            for k, v in enumerate(self.variants):
+                a.text(steps[k], k, f" {v['dofs']} dofs, {100 * v['freq_error_top']:.2g} %", va="center", fontsize=7)
+            a.set_xlabel("explicit step at the top speed [ms] (log); dofs, top-speed error")
+            a.set_title("what each reduction allows (green: the one kept)")
+            a.grid(alpha=0.3, axis="x")
+        else:
+            a.text(0.5, 0.5, "the reductions were not compared\n(a large model: --compare-reductions)",
+                   ha="center", va="center", transform=a.transAxes, color="0.35")
+            a.set_axis_off()
+        fig.suptitle(f"Imported blade: {b.info.get('source', '')} ({b.info.get('dofs_full')} dofs -> {b.m})",
+                     fontsize=11)
         return fig
 
     def save(self, out: str | Path) -> dict:
@@ -213,7 +233,7 @@ def run_import_blade(fe: FEModel | ReducedBlade, tip_nodes=None, *, cutoff_hz: f
     t0 = time.perf_counter()
     if variants is None:
         variants = fe.n_dofs <= VARIANTS_MAX_DOFS
-    diag: dict = {}
+    diag: dict = {"keep_factor": bool(variants)}  # K0's factorization outlives the reduction only for the comparison
     if isinstance(fe, ReducedBlade):
         raise FEImportError("import-blade: a superelement is already reduced; load it with load_superelement")
     blade = reduce_blade(fe, tip_nodes, cutoff_hz=cutoff_hz, basis=basis, diagnostics=diag, **kw)
