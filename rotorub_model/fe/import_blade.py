@@ -288,7 +288,10 @@ def run_import_blade(fe: FEModel | ReducedBlade, tip_nodes=None, *, cutoff_hz: f
         notes.append(f"the reductions were not compared ({fe.n_dofs} dofs > {VARIANTS_MAX_DOFS}, or one speed, or "
                      "constrained tip translations): --compare-reductions to force it")
     if speeds.size < 2:
-        notes.append("one stiffness only: the stress stiffening is neglected (spin softening from M is in)")
+        w_div = [float(v) for v in np.linspace(0.0, 2000.0, 401) if blade.frequencies(float(v))[0] < 1e-6]
+        notes.append("one stiffness only: the stress stiffening is neglected (the spin softening from M is in)"
+                     + (f"; the first mode softens to zero at {w_div[0]:.4g} rad/s: fit for speeds well below" if w_div
+                        else ""))
     return ImportBladeResult(blade=blade, speeds=speeds, full_hz=full, own_hz=own_hz, reduced_hz=red,
                              mac_rest=mac_rest, mac_top=mac_top, convergence=conv, variants=var, step=step,
                              seconds={"reduce": t_reduce, "reductions_compared": t_var}, k_r=float(k_r),

@@ -206,3 +206,15 @@ def test_superelement_round_trip(tmp_path, beam):
     for key in ("M", "D", "K", "G1", "N2", "S2", "E1", "S4"):
         assert np.array_equal(getattr(a, key), getattr(b, key)), key
     assert a.dofs == b.dofs and a.dofs[2 * p.shaft.n_ritz] == "blade1.m1"
+
+
+def test_one_stiffness_keeps_the_spin_softening_only(tmp_path):
+    """From the rest stiffness alone the blade gets the spin softening from M and the coordinates, exactly the
+    built-in's -cos^2(beta) M on the flap direction, and no stress stiffening (it needs the prestress)."""
+    p = undamped()
+    info = write_beam_blade(p, tmp_path, speeds=(0.0,), n_elements=60)
+    blade = reduce_blade(read(info), [info["tip_node"]], axis_direction=info["axis_direction"])
+    assert blade.info["order"] == 0
+    assert np.abs(blade.stress_stiffening).max() < 1e-12 * np.abs(blade.K0).max()
+    beta = np.radians(p.blades.stagger_deg)
+    assert np.allclose(blade.K1, -np.cos(beta) ** 2 * blade.M, rtol=1e-12, atol=1e-12 * np.abs(blade.M).max())

@@ -205,6 +205,7 @@ BAD = [
     ("negative mass", "neg_mass", "mass is not positive"),
     ("missing file", lambda i, t: read(i, mass=t / "nothing.mtx"), "no such file"),
     ("CalculiX jobs of two meshes", "ccx_two_meshes", "dof map differs"),
+    ("unclamped-mass job of another mesh", "ccx_free_other", "mass on the free dofs differs"),
     ("superelement with a field missing", "se_missing", "missing"),
 ]
 
@@ -269,6 +270,14 @@ def _make(kind, info, t):
         lines = jobs[1].with_suffix(".dof").read_text().splitlines()
         jobs[1].with_suffix(".dof").write_text("\n".join(lines[2:] + lines[:2]) + "\n")
         return read_calculix(jobs)
+    elif kind == "ccx_free_other":
+        jobs = write_calculix(info, t / "ccx")
+        free = t / "ccx" / "free"
+        for suffix in (".dof", ".sti"):
+            free.with_suffix(suffix).write_text(jobs[0].with_suffix(suffix).read_text())
+        rows = [line.split() for line in jobs[0].with_suffix(".mas").read_text().splitlines()]
+        free.with_suffix(".mas").write_text("".join(f"{a} {b} {1.1 * float(v)!r}\n" for a, b, v in rows))
+        return read_calculix(jobs, mass_free=free)
     elif kind == "se_missing":
         b = reduce(read(info), info)
         b.save(t / "b.npz")
