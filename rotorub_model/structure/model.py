@@ -53,6 +53,7 @@ class Model:
     f_euler: np.ndarray  # inertia load of the blades at dOmega/dt = 1 rad/s^2
     slices: dict[str, slice]
     mistuning: tuple[float, ...] | None = None  # per-blade stiffness deviations (build_model); None: tuned
+    S4: np.ndarray | None = None  # Omega^4 term of an imported blade's prestressed stiffness (None: the built-in's)
 
     @property
     def n_dofs(self) -> int:
@@ -64,7 +65,7 @@ class Model:
     def K_omega(self, omega: float) -> np.ndarray:
         """K(Omega) = K + Ks(Omega^2) + N(Omega) + C(Omega): the kernel's (rr_k_omega), the same bits the FMUs and
         the time loop's matrices use."""
-        return kernel.k_omega(self.K, self.S2, self.N2, self.C1, float(omega))
+        return kernel.k_omega(self.K, self.S2, self.N2, self.C1, float(omega), self.S4)
 
     def force(self, omega: float, me: float | None = None, omega_dot: float = 0.0) -> np.ndarray:
         """Imbalance force F(Omega^2) (constant in the rotating frame); with an angular
@@ -86,6 +87,33 @@ class Model:
         from .cyclic import cyclic_blocks
 
         return cyclic_blocks(self)
+
+    @cached_property
+    def block_layout(self) -> tuple[int, int, int, int] | None:
+        """(hub dofs, blades, dofs per blade, casing dofs) when the matrices are arrows: the blades couple to the
+        shaft only, the casing to nothing (it meets the rotor through contact); what the time loop's block step
+        needs (a step then costs what grows linearly with the blades). None when any block breaks the pattern."""
+        sh, bl, cs = self.slices["shaft"], self.slices["blades"], self.slices["casing"]
+        nb = self.params.blades.count
+        nblade = bl.stop - bl.start
+        if nb < 1 or nblade % nb:
+            return None
+        m = nblade // nb
+        mats = [self.M, self.D, self.K, self.G1, self.C1, self.N2, self.S2, self.E1]
+        if self.S4 is not None:
+            mats.append(self.S4)
+        rotor = slice(sh.start, bl.stop)
+        for A in mats:
+            if np.any(A[rotor, cs]) or np.any(A[cs, rotor]):
+                return None
+            B = A[bl, bl]
+            for j in range(nb):
+                rows = slice(j * m, (j + 1) * m)
+                off = np.abs(B[rows]).copy()
+                off[:, rows] = 0.0
+                if np.any(off):
+                    return None
+        return sh.stop - sh.start, nb, m, cs.stop - cs.start
 
     @cached_property
     def M_inv(self) -> np.ndarray:

@@ -71,7 +71,7 @@ void model_free(model_runtime *m)
 static double critical_step(model_runtime *m, double w)
 {
     const model_data *d = &MODEL_DATA;
-    rr_k_omega(m->n, d->K, d->S2, d->N2, d->C1, w, m->Kw);
+    rr_k_omega(m->n, d->K, d->S2, d->N2, d->C1, NULL, w, m->Kw);
     return rr_critical_step(&m->contact, w, m->Minv, m->Kw, m->Aeig); /* Aeig: 4 n^2 of scratch */
 }
 
@@ -371,7 +371,7 @@ static model_status transient_step(model_runtime *m, model_values *v, double w, 
     dt = h / ns;
     /* the matrices first: a step refused here leaves the state as it was (the two-step scheme untouched) */
     if (!m->have_mats || m->mats_omega != w || m->mats_dt != dt) {
-        if (rr_cd_build(n, d->M, d->D, d->K, d->G1, d->C1, d->N2, d->S2, NULL, w, 0.0, dt, m->Ainv, m->K2, m->Cm1,
+        if (rr_cd_build(n, d->M, d->D, d->K, d->G1, d->C1, d->N2, d->S2, NULL, NULL, w, 0.0, dt, m->Ainv, m->K2, m->Cm1,
                         m->mwork, m->piv) != 0) {
             m->have_mats = 0; /* the buffers hold a failed build */
             snprintf(msg, len, "the central-difference matrix is singular at %g rad/s, dt = %g s", w, dt);
@@ -428,7 +428,7 @@ static model_status static_solution(model_runtime *m, model_values *v, double w,
     double rel, gmin, max_real = -HUGE_VAL;
     double *q = m->Ainv; /* the transient buffers are free in this mode: the candidate solution */
     double *J = m->K2, *A = m->Aeig, *C = m->Cm1;
-    rr_k_omega(m->n, d->K, d->S2, d->N2, d->C1, w, m->Kw);
+    rr_k_omega(m->n, d->K, d->S2, d->N2, d->C1, NULL, w, m->Kw);
     for (i = 0; i < n; ++i) m->Fw[i] = me * w * w * d->f_unit[i];
     m->contact.g0 = m->g0 - v->r[VR_CLEARANCE_CLOSURE]; /* the engine's closure: uniform, so a balanced solution still is */
     ok = rr_static_solve(&m->contact, w, m->Kw, m->Fw, m->have_qs ? m->qs : NULL, 1e-10, 60, q, &rel, &its, m->swork,
