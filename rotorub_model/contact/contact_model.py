@@ -389,6 +389,13 @@ def make_contact(model: Model, formulation: str = "3D", variant: str = "full", *
         c = model.params.replace(contact=overrides).contact
     if formulation == "2D":
         geo = geometry_2d(model)
+    elif getattr(model, "fe_blade", None) is not None:  # an imported blade: its tip's chord stations
+        if variant != "full":
+            raise ParameterError(f"variant: '{variant}' is the paper's study of its beam blades; accepted with an "
+                                 "imported blade: full")
+        from .fe_tip import geometry_fe
+
+        geo = geometry_fe(model, np.radians(c.theta_deg), model.params.fe_blade.stations)
     else:
         theta, chord = np.radians(c.theta_deg), c.chord
         if variant == "kinematics_only":
