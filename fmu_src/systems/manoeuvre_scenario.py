@@ -44,6 +44,9 @@ SPEED = 224.28  # rad/s: the coupled and wear scenarios' top speed (4.2 omega_re
 IMBALANCE = 0.5 * ME_REF  # kg m: 11 kg mm, see the module docstring
 H = 1e-3  # s
 LEVEL_FLIGHT = {"load_factor_peak": 1.0}  # the reference: the same package, nothing distorted
+# the same pull-up with the casing centre moved across the oval (horizontally, as a pitch manoeuvre's gyroscopic
+# moment yaws the rotor) instead of along it: one tight side closes more than the other
+OFFSET_ACROSS = {"offset_angle": 0.0}
 CASING_OUTPUTS = ("load_factor", "casing_lobe2.amplitude", "casing_lobe2.phase", "casing_offset.x",
                   "casing_offset.y")
 CONTACT_OUTPUTS = ("gap_min", "friction_torque", "n_contact", "wear.depth_max", "wear.depth_mean", "wear.volume",
@@ -168,14 +171,23 @@ def run_manoeuvre_scenario(out_dir: str | Path, quick: bool = True, fmu_dir: str
     run = run_ssp_fmpy(ssp, cfg["t_end"], cfg["h"], record)
     fmpy_s = time.perf_counter() - t1
     ref = run_ssp_fmpy(level, cfg["t_end"], cfg["h"], record)
+    across_ssp = write_manoeuvre_ssp(out / "RotorRubEngineManoeuvre_offset_across.ssp", fmus, cfg, OFFSET_ACROSS,
+                                     name="RotorRubEngineManoeuvreOffsetAcross")
+    wear = (("contact", "wear.depth_max"), ("contact", "wear.lobes"),
+            *(("contact", f"wear.harmonic[{k}]") for k in range(1, 9)))
+    across = run_ssp_fmpy(across_ssp, cfg["t_end"], cfg["h"], wear)
     np.savez_compressed(out / "manoeuvre_engine.npz", **{k.replace(".", "__"): v for k, v in run.items()},
                         **{f"level_flight__{k.replace('.', '__')}": v for k, v in ref.items()})
     contact_vars, _, _ = read_description(fmus["contact"])
     liner = {"yield_force_N": float(contact_vars["yield_force"].start), "k_r_N_m": float(contact_vars["k_r"].start)}
     summary = summarize(run, ref, cfg, liner)
+    summary.update({"offset_across_oval_wear_depth_max_mm": float(across["contact.wear.depth_max"][-1]) * 1e3,
+                    "offset_across_oval_wear_lobes": int(across["contact.wear.lobes"][-1]),
+                    "offset_across_oval_wear_harmonics_mm": [float(across[f"contact.wear.harmonic[{k}]"][-1]) * 1e3
+                                                             for k in range(1, 9)]})
     summary.update({"quick": quick, "ssp": str(ssp), "ssp_level_flight": str(level), "ssp_valid": True,
                     "build_time_s": build_s, "fmpy_wall_time_s": fmpy_s})
-    plot_manoeuvre_scenario(run, ref, summary, out / "manoeuvre_engine.png")
+    plot_manoeuvre_scenario(run, ref, summary, out / "manoeuvre_engine.png", across)
     if masters:
         for key, package, fmpy_run in (("masters", ssp, run), ("masters_level_flight", level, ref)):
             summary[key] = _masters(package, cfg, record, fmpy_run)
@@ -236,9 +248,10 @@ def summarize(run: dict, ref: dict, cfg: dict, liner: dict) -> dict:
     }
 
 
-def plot_manoeuvre_scenario(run: dict, ref: dict, s: dict, path: Path) -> Path:
-    """Six panels: the casing load, gap_min, the blades' normal forces, the worn depth, the wear's harmonics and
-    lobes over time, and the casing's gap around the circumference at the peak."""
+def plot_manoeuvre_scenario(run: dict, ref: dict, s: dict, path: Path, across: dict | None = None) -> Path:
+    """Six panels: the casing load, gap_min, the blades' normal forces, the worn depth (and, given ``across``, that
+    of the run whose offset lies across the oval), the wear's harmonics and lobes over time, and the casing's gap
+    around the circumference at the peak."""
     plt = pyplot()
     t = run["t"]
     fig, ax = plt.subplots(3, 2, figsize=(13, 10.5))
@@ -263,6 +276,7 @@ def plot_manoeuvre_scenario(run: dict, ref: dict, s: dict, path: Path) -> Path:
               label=f"−F_y/k_r = −{s['liner_elastic_limit_mm'] * 1e3:.0f} µm: the liner yields")
     a.set_ylabel("gap_min (smallest blade gap) [mm]")
     a.set_title("the oval's tight sides close the gap", fontsize=9)
+    a.set_ylim(bottom=-0.28)  # room for the legend below the curves
     a.legend(fontsize=7, loc="lower left")
 
     a = ax[1, 0]
@@ -283,12 +297,15 @@ def plot_manoeuvre_scenario(run: dict, ref: dict, s: dict, path: Path) -> Path:
     a.set_ylabel("normal contact force [N]")
     a.set_title(f"blade forces ({len(blades)} blades, a revolution = {n} steps; max {s['max_contact_force_N']:.0f} N)",
                 fontsize=9)
-    a.legend(fontsize=7, loc="upper left")
+    a.legend(fontsize=7, loc="center left")
 
     a = ax[1, 1]
     a.plot(t, run["contact.wear.depth_max"] * 1e6, "C3", lw=1.4, label="deepest wear")
     a.plot(t, run["contact.wear.depth_mean"] * 1e6, "C3", lw=1, ls="-.", label="mean worn depth")
     a.plot(t, ref["contact.wear.depth_max"] * 1e6, "k--", lw=1, label="level flight: deepest wear")
+    if across is not None:
+        a.plot(across["t"], across["contact.wear.depth_max"] * 1e6, "C4:", lw=1.2,
+               label=f"offset across the oval instead: deepest wear ({s['offset_across_oval_wear_lobes']} lobe)")
     a.set_ylabel("worn depth of the liner [µm]")
     a.set_title(f"wear {s['wear_depth_max_mm'] * 1e3:.1f} µm deep, {s['wear_volume_mm3']:.3g} mm³ "
                 f"(level flight: {s['level_flight_wear_depth_max_mm'] * 1e3:g} µm)", fontsize=9)
@@ -333,6 +350,10 @@ def plot_manoeuvre_scenario(run: dict, ref: dict, s: dict, path: Path) -> Path:
     return save_figure(fig, path)
 
 
+def _lobes(n: int) -> str:
+    return "no lobe dominating" if n == 0 else f"{n} lobe" + ("s" if n > 1 else "")
+
+
 def report_section(s: dict) -> str:
     """The report's markdown about the scenario's summary ``s``."""
     def largest(key: str, master: str) -> str:
@@ -351,7 +372,10 @@ def report_section(s: dict) -> str:
         f"{s['offset_peak_mm']:.3g} mm: the sides at {tp} close, the blades rub from t = "
         f"{s['t_first_contact_s']} s (up to {s['max_contact_force_N']:.0f} N) and cut the liner "
         f"{s['wear_depth_max_mm'] * 1e3:.1f} µm deep in **{s['wear_lobes']} lobes** "
-        f"({s['wear_volume_mm3']:.3g} mm³). The package and its level-flight reference run the same in fmpy, in "
+        f"({s['wear_volume_mm3']:.3g} mm³). The same pull-up with the offset across the oval (horizontal, as the "
+        f"gyroscopic moment yaws the rotor) closes one side more than the other: "
+        f"{s['offset_across_oval_wear_depth_max_mm'] * 1e3:.1f} µm deep, {_lobes(s['offset_across_oval_wear_lobes'])}: "
+        "the lobes tell which load dominated. The package and its level-flight reference run the same in fmpy, in "
         f"libcosim (largest relative difference {largest('masters', 'libcosim')}; level flight "
         f"{largest('masters_level_flight', 'libcosim')}) and in the C master ({largest('masters', 'native_host')}; "
         f"{largest('masters_level_flight', 'native_host')}).", ""])

@@ -94,6 +94,16 @@ def test_the_manoeuvre_makes_the_rub_and_wears_two_lobes(scenario):
     assert s["spool_speed_dip_rad_s"] > 0.0 and p["t_start"] == t0
 
 
+def test_an_offset_across_the_oval_wears_one_side(scenario):
+    """The same pull-up with the casing centre moved horizontally (across the oval, as a gyroscopic yaw would) closes
+    one tight side by a2 + e and opens the other to a2 - e: the blades cut one side only, deeper, and the wear has
+    one lobe (harmonic 1 the largest). Would fail if the offset's direction or the lobe rule were wrong."""
+    s = scenario["summary"]
+    assert s["offset_across_oval_wear_lobes"] == 1
+    h = s["offset_across_oval_wear_harmonics_mm"]
+    assert h[0] == max(h) and s["offset_across_oval_wear_depth_max_mm"] > 1.5 * s["wear_depth_max_mm"]
+
+
 def test_how_long_the_peak_is_held_changes_no_wear(scenario, fmus, tmp_path):
     """The liner's law is rate-independent: once the tight sides are cut, the blades pass at the yield force. A
     pull-up held 0.5 s instead of 2 s wears the same depth (to 1e-6: the rise and the peak are the same)."""
