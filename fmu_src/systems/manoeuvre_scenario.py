@@ -100,7 +100,11 @@ def casing_gap(theta: np.ndarray, g0: float, closure: float, a2: float, psi: flo
 
 def tight_points(g0: float, closure: float, a2: float, psi: float, ex: float, ey: float) -> list[tuple[float, float]]:
     """(angle [deg], gap [m]) of the casing's local minima of :func:`casing_gap` (two for an oval, unless the offset
-    outweighs it), from a fine grid refined by a parabola through the three points around each."""
+    outweighs it), from a fine grid refined by a parabola through the three points around each.
+
+    >>> [(round(a), round(g * 1e3, 6)) for a, g in tight_points(1e-3, 0.0, 2e-4, 0.0, 0.0, 0.0)]  # widest at 0 deg
+    [(90, 0.8), (270, 0.8)]
+    """
     n = 3600
     th = np.arange(n) * 2.0 * math.pi / n
     g = casing_gap(th, g0, closure, a2, psi, ex, ey)

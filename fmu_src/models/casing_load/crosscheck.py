@@ -28,7 +28,14 @@ OUTPUTS = ("load_factor", "schedule", "casing_lobe2.amplitude", "casing_lobe2.ph
 
 
 def closed_form(t: np.ndarray, **values: float) -> dict[str, np.ndarray]:
-    """The outputs at the times ``t`` for the parameters DEFAULTS updated by ``values``."""
+    """The outputs at the times ``t`` for the parameters DEFAULTS updated by ``values``.
+
+    >>> out = closed_form(np.array([0.0, 1.25, 2.0, 4.0]))  # before, half-way up, held, back to level flight
+    >>> [round(float(x), 12) for x in out["load_factor"]]
+    [1.0, 1.75, 2.5, 1.0]
+    >>> round(float(closed_form(np.array([2.0]), load_factor_peak=-1.0)["casing_lobe2.amplitude"][0]), 12)
+    -0.0006
+    """
     p = {**lv.DEFAULTS, **values}
     t = np.asarray(t, dtype=float)
     t0, tr, th, tf = p["t_start"], p["t_rise"], p["t_hold"], p["t_fall"]

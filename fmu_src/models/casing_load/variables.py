@@ -17,9 +17,10 @@ proportional to n - 1: one offset per g, with its direction, holds both). Level 
 distorts nothing: the reference of fmu_src/systems/manoeuvre_scenario.py.
 
 Defaults (reasons in FMU.md): load_factor_peak 2.5 (the limit manoeuvring load factor of a transport aeroplane,
-CS/14 CFR 25.337); ovalization 0.3 mm per g (0.45 mm at 2.5 g), widest on the vertical (phase pi/2, the casing hung
-at its top mount and pulled along the load line); offset 0.05 mm per g upwards (the casing centre rising over a
-rotor that sags on its bearings). The fixed frame's Y is taken vertical, up. The model is model.c next to this file.
+CS/14 CFR 25.337); ovalization 0.3 mm per g (0.45 mm at 2.5 g; a choice, five times the reference ring's own under
+the case's weight), widest on the vertical (phase pi/2: a ring pulled at its top mount lengthens along the pull);
+offset 0.05 mm per g, vertical (a choice: the carcass bending the reference model does not have). The fixed frame's
+Y is taken vertical, up. The model is model.c next to this file.
 """
 
 from __future__ import annotations
