@@ -411,12 +411,18 @@ def run_ssp_libcosim(ssp: str | Path, t_end: float, h: float = 1e-3,
             raise EngineError(f"run_ssp_libcosim: component '{comp}' has no variable '{var}'")
         refs[f"{comp}.{var}"] = (index[comp], *names[var])
     out = {k: np.empty(steps) for k in refs}
+    groups: dict[tuple[int, int], list[tuple[str, int]]] = {}  # one observer call per component and type
+    for key, (i, ref, typ) in refs.items():  # libcosim's variable types: 0 Real, 1 Integer
+        groups.setdefault((i, typ), []).append((key, ref))
     for k in range(steps):
         if not ex.step(1):
             raise EngineError(f"run_ssp_libcosim: step {k} (t = {k * h:g} s) failed; libcosim state "
                               f"{ex.status().state}")
-        for key, (i, ref, typ) in refs.items():  # libcosim's variable types: 0 Real, 1 Integer
-            out[key][k] = (observer.last_integer_values if typ == 1 else observer.last_real_values)(i, [ref])[0]
+        for (i, typ), items in groups.items():
+            values = (observer.last_integer_values if typ == 1 else observer.last_real_values)(
+                i, [ref for _key, ref in items])
+            for (key, _ref), v in zip(items, values):
+                out[key][k] = v
     del ex, observer
     return {"t": (np.arange(steps) + 1) * h, **out}
 
@@ -541,8 +547,10 @@ def run_ssp_fmpy(ssp: str | Path, t_end: float, h: float | None = None,
             for comp, var in record:
                 if comp not in by or var not in by[comp]["vr"]:
                     raise EngineError(f"run_ssp_fmpy: no variable {comp}.{var} in {ssp}")
-            probes = [(slaves[comp].fmu, by[comp]["vr"][var], slaves[comp].variables[var].type)
-                      for comp, var in record]
+            probes: dict[tuple[str, bool], list[tuple[int, int]]] = {}  # one get per component and type
+            for j, (comp, var) in enumerate(record):
+                probes.setdefault((comp, slaves[comp].variables[var].type == "Real"), []).append(
+                    (j, by[comp]["vr"][var]))
             out = np.empty((steps, len(record)))
             for k in range(steps):
                 values = [src.getReal([vr])[0] for src, vr, _d, _v in links]  # Jacobi: every output at t_k first
@@ -554,8 +562,9 @@ def run_ssp_fmpy(ssp: str | Path, t_end: float, h: float | None = None,
                 except FMICallException as exc:
                     msgs = [f"{n}: {msg}" for n, s in slaves.items() for msg in s.log.problems(0)]
                     raise EngineError(f"run_ssp_fmpy: step at t = {k * h:g} s refused ({exc})", msgs) from None
-                for j, (f, vr, typ) in enumerate(probes):
-                    out[k, j] = f.getReal([vr])[0] if typ == "Real" else f.getInteger([vr])[0]
+                for (comp, real), items in probes.items():
+                    f = slaves[comp].fmu
+                    out[k, [j for j, _vr in items]] = (f.getReal if real else f.getInteger)([vr for _j, vr in items])
         except FMUError as exc:
             raise EngineError(f"run_ssp_fmpy: {exc}", exc.messages) from None
         finally:
