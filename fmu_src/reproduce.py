@@ -76,6 +76,7 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
         "branch are counted in harnesses.quasi_static.vs_library)")
 
     from .systems.coupling import run_coupled_scenario
+    from .systems.manoeuvre_scenario import run_manoeuvre_scenario
     from .systems.wear_scenario import run_wear_scenario
 
     _step("coupled engine scenario: LP spool FMU + contact FMU, fmpy master loop, SSP file")
@@ -86,14 +87,21 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
           "masters)")
     wear = run_wear_scenario(out / "coupled_wear", quick=quick, fmu_dir=Path(fmu_dir) / "wear" if fmu_dir else None)
     res["coupled_wear_run"] = {k: v for k, v in wear.items() if k != "figures"}
+
+    _step("engine scenario with a manoeuvre: a 2.5 g pull-up ovalizes the fan case (CasingLoad FMU), the blades cut "
+          "it (SSP, three masters)")
+    man = run_manoeuvre_scenario(out / "coupled_manoeuvre", quick=quick,
+                                 fmu_dir=Path(fmu_dir) / "manoeuvre" if fmu_dir else None)
+    res["coupled_manoeuvre_run"] = man["summary"]
     res["figures_extra"] = [
         ("Contact and stability maps through the FMU (quasi-static sweeps)", "fmu_quasi_static/fmu_maps.png"),
         ("Normal contact forces through the FMU, 2D vs 3D (paper Fig. 12)", "fmu_transient/fmu_contact_forces.png"),
         ("Run-up through the first critical speed through the FMU", "fmu_run_up/run_up.png"),
         *[(t, str(Path("coupled") / p)) for t, p in coupled.get("figures", [])],
         *[(t, str(Path("coupled_wear") / p)) for t, p in wear.get("figures", [])],
+        *[(t, str(Path("coupled_manoeuvre") / p)) for t, p in man.get("figures", [])],
     ]
-    return {"summary": res, "markdown": report_section(res)}
+    return {"summary": res, "markdown": report_section(res) + man["markdown"]}
 
 
 # ---------------------------------------------------------------------------------------------- the report's section
