@@ -57,6 +57,12 @@ def all_closed_stiffness(contact: ContactModel, omega: float) -> np.ndarray:
 def critical_time_step(model: Model, contact: ContactModel, omega: float) -> float:
     """2 / w_max of the linearised system with all contacts closed at the law's largest slope [s]: the kernel's
     (rr_critical_step), which both FMUs call too, so all pick the same step."""
+    # the limit depends on the model, the law and the speed only (every contact closed: not on g0): kept on the
+    # contact model, so a study's runs at one speed compute it once
+    cache = contact.__dict__.setdefault("_step_limits", {})
+    key = (id(model), float(omega))
+    if key in cache and cache[key][0] is model:
+        return cache[key][1]
     n = model.n_dofs
     Minv = kernel.inverse(model.M)  # the kernel's LU, as the FMUs invert M
     Kw = np.ascontiguousarray(model.K_omega(omega))
@@ -64,6 +70,7 @@ def critical_time_step(model: Model, contact: ContactModel, omega: float) -> flo
     dt = contact.lib.rr_critical_step(contact.kernel, float(omega), kernel.ptr(Minv), kernel.ptr(Kw), kernel.ptr(work))
     if not dt > 0:
         raise ParameterError("the central-difference stability limit: the eigenvalue iteration did not converge")
+    cache[key] = (model, float(dt))
     return float(dt)
 
 

@@ -126,7 +126,7 @@ class ContactModel:
 
     def __getstate__(self) -> dict:
         # ctypes objects do not pickle: a copy in another process builds its own view
-        state = {k: v for k, v in self.__dict__.items() if k not in ("_k", "_pinned", "_lib")}
+        state = {k: v for k, v in self.__dict__.items() if k not in ("_k", "_pinned", "_lib", "_step_limits")}
         state["_k"] = None
         return state
 
