@@ -14,7 +14,6 @@ RR_API void bare_cd(const rr_contact *c, const rr_cd_matrices *m, double *q, dou
         rri_gaps_of(c, q, gaps);
         rri_laws_of(c, gaps, law);
         rri_friction_of(c, law, omega, NULL, q, qp, dt, fr);
-        rri_cd_update(c->n, nb, c->np, c->chord, law, fr, c->A, c->B, c->S, m->Ainv, m->K2, m->Cm1, m->f, m->f0, me, q,
-                  qp, rhs);
+        rri_cd_update(c, law, fr, m, me, q, qp, rhs);
     }
 }

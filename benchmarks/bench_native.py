@@ -93,7 +93,7 @@ def main(argv: list[str] | None = None) -> int:
         c = make_contact(m, "3D", g0=g0)
         cd = CentralDifference(m, c, dt=h / 2, t_ramp=0.0)
         mats = cd._matrices(omega, 0.0)
-        bare = bare_library(tmp)
+        bare = bare_library(tmp, target="linux64")  # the FMU's linux64 binary's compiler (ziglang)
         q, qp = np.zeros(m.n_dofs), np.zeros(m.n_dofs)
         n_sub = 2 * (ns.steps - 1)
 
@@ -123,7 +123,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"native FMU in the C host: instantiate -> end of first step {host_start * 1e3:8.3f} ms (target <= 20 ms)")
     print(f"native FMU in the C host: {host_step * 1e6:8.2f} us per communication step")
     print(f"bare compiled loop, same 2 substeps: {t_bare * 1e6:8.2f} us")
-    print(f"ratio C host / bare loop: {host_step / t_bare:8.2f}  (target <= 1.5)")
+    print(f"ratio C host / bare loop: {host_step / t_bare:8.2f}  (target <= 1.15)")
     print(f"fmpy FMU2Slave loop: native {t_nat * 1e6:8.2f} us/step, pythonfmu {t_py * 1e6:8.2f} us/step; "
           f"pythonfmu / native = {t_py / t_nat:6.1f}  (target >= 10)")
     return 0

@@ -13,7 +13,8 @@ imbalance ramped over 1 s, outputs every 1 ms.
   10 blades and its projection, the kernel's own code) and nothing else, compiled with the
   same compiler and flags as the kernel, called once.
 
-Printed: time per step of each and the ratio library / bare (target <= 1.3).
+Printed: time per step of each and the ratio library / bare (target <= 1.25, issue 24). The three are timed in turn,
+best of ``--repeat`` rounds after a warm-up (a ratio of runs made under the same conditions).
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from timing import best_of
+from timing import best_of_interleaved
 
 from rotorub_model import kernel
 from rotorub_model.analyses.transient import CentralDifference, run_transient
@@ -35,9 +36,12 @@ from rotorub_model.structure.model import build_model
 HERE = Path(__file__).resolve().parent
 
 
-def bare_library(tmp: Path) -> ctypes.CDLL:
+def bare_library(tmp: Path, target: str | None = None) -> ctypes.CDLL:
+    """The bare loop compiled with the kernel's compiler (``target``: an FMI platform folder, to build it with the
+    compiler the native FMU's binary is built with, ziglang's clang: a ratio against the FMU compares one compiler's
+    code with itself)."""
     out = compile_shared([HERE / "bare_loop.c", *kernel.SOURCES], tmp / f"bare_loop{host_suffix()}",
-                         include=[kernel.HERE])
+                         include=[kernel.HERE], target=target)
     lib = ctypes.CDLL(str(out))
     dp = ctypes.c_void_p
     lib.bare_cd.argtypes = [ctypes.POINTER(kernel.RRContact), ctypes.POINTER(kernel.RRMatrices), dp, dp,
@@ -49,7 +53,7 @@ def bare_library(tmp: Path) -> ctypes.CDLL:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--t-end", type=float, default=2.5)
-    ap.add_argument("--repeat", type=int, default=9)
+    ap.add_argument("--repeat", type=int, default=25)
     ns = ap.parse_args(argv)
 
     m = build_model()
@@ -77,9 +81,10 @@ def main(argv: list[str] | None = None) -> int:
             bare.bare_cd(c.kernel, mats, kernel.ptr(q), kernel.ptr(qp), r.dt, omega, n_steps, me)
 
         bare_run()
-        t_lib = best_of(library, ns.repeat)
-        t_hold = best_of(library_hold, ns.repeat)
-        t_bare = best_of(bare_run, ns.repeat)
+        for _ in range(3):  # warm-up of every path (allocators, caches, the frequency governor)
+            library(), library_hold(), bare_run()
+        t = best_of_interleaved({"lib": library, "hold": library_hold, "bare": bare_run}, ns.repeat)
+        t_lib, t_hold, t_bare = t["lib"], t["hold"], t["bare"]
     h = library_hold()
     print(f"model: {m.n_dofs} dofs, 3D contact ({c.n_blades} blades x {c.n_points} points); "
           f"{n_steps} steps of {r.dt:.3e} s ({ns.t_end:g} s), records every 1 ms: {len(r.t)}")
@@ -87,7 +92,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"run_transient end to end       : {t_lib / n_steps * 1e9:8.1f} ns/step  ({t_lib * 1e3:.1f} ms)")
     print(f"run_transient(hold=1 ms)       : {t_hold / n_steps * 1e9:8.1f} ns/step  ({t_hold * 1e3:.1f} ms)")
     print(f"bare compiled loop (no outputs): {t_bare / n_steps * 1e9:8.1f} ns/step  ({t_bare * 1e3:.1f} ms)")
-    print(f"ratio run_transient / bare     : {t_lib / t_bare:8.2f}  (target <= 1.3)")
+    print(f"ratio run_transient / bare     : {t_lib / t_bare:8.2f}  (target <= 1.25)")
     print(f"ratio hold / bare              : {t_hold / t_bare:8.2f}")
     print(f"simulated seconds per wall second: {ns.t_end / t_lib:8.1f}")
     return 0

@@ -14,3 +14,16 @@ def best_of(fn: Callable[[], object], repeat: int = 5) -> float:
         fn()
         best = min(best, time.perf_counter() - t)
     return best
+
+
+def best_of_interleaved(fns: dict[str, Callable[[], object]], repeat: int = 5) -> dict[str, float]:
+    """The best of ``repeat`` runs of each function, the functions taken in turn within each round: a ratio of two
+    of them then compares runs made under the same conditions (a machine that warms up, or gets busier, over the
+    measurement moves both alike)."""
+    best = {k: float("inf") for k in fns}
+    for _ in range(repeat):
+        for k, fn in fns.items():
+            t = time.perf_counter()
+            fn()
+            best[k] = min(best[k], time.perf_counter() - t)
+    return best

@@ -24,7 +24,8 @@ def _step(msg: str, progress: bool = True):
 
 def build_all(fmu_dir: str | Path = "fmus", params_file: str | Path | None = None) -> dict:
     """Every FMU the FMU half runs, for this machine only: both flavours of the contact FMU (with their cross-check
-    kits), the spool FMU of the coupled scenario and the three FMUs of the scenario with wear.
+    kits), the spool FMU of the coupled scenario, the three FMUs of the scenario with wear and the four of the
+    manoeuvre.
 
     This machine's only, because the harnesses, the masters and the C hosts all run here: a cold ziglang cache
     compiles each target's C library first (measured on 2 cores: linux64 17 s, aarch64-linux 22 s, darwin64 17 s,
@@ -34,6 +35,8 @@ def build_all(fmu_dir: str | Path = "fmus", params_file: str | Path | None = Non
     from .fmi.compile import host_platform
     from .models.spool.builder import build_native_spool_fmu
     from .systems.coupling import scenario_settings
+    from .systems.manoeuvre_scenario import build_manoeuvre_fmus
+    from .systems.manoeuvre_scenario import scenario_settings as manoeuvre_settings
     from .systems.wear_scenario import build_wear_fmus
 
     plats = (host_platform(),)
@@ -42,7 +45,9 @@ def build_all(fmu_dir: str | Path = "fmus", params_file: str | Path | None = Non
             "native": build(fmu_dir / "native", params_file, native=True, platforms=plats),
             "spool": build_native_spool_fmu(fmu_dir / "native", platforms=plats),
             "wear": build_wear_fmus(fmu_dir / "wear", platforms=plats,
-                                    omega0=scenario_settings(True)["spool_params"]["Omega0"])}
+                                    omega0=scenario_settings(True)["spool_params"]["Omega0"]),
+            "manoeuvre": build_manoeuvre_fmus(fmu_dir / "manoeuvre", platforms=plats,
+                                              omega0=manoeuvre_settings(True)["speed"])}
 
 
 def start_builds(fmu_dir: str | Path = "fmus", params_file: str | Path | None = None):
@@ -114,6 +119,7 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
         "branch are counted in harnesses.quasi_static.vs_library)")
 
     from .systems.coupling import run_coupled_scenario
+    from .systems.manoeuvre_scenario import run_manoeuvre_scenario
     from .systems.wear_scenario import run_wear_scenario
 
     with _step("coupled engine scenario: LP spool FMU + contact FMU, fmpy master loop, SSP file", progress):
@@ -125,19 +131,26 @@ def run_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: st
                "masters)", progress):
         wear = run_wear_scenario(out / "coupled_wear", quick=quick, fmus=built["wear"], platforms=plats)
     res["coupled_wear_run"] = {k: v for k, v in wear.items() if k != "figures"}
+
+    with _step("engine scenario with a manoeuvre: a 2.5 g pull-up ovalizes the fan case (CasingLoad FMU), the blades "
+               "cut it (SSP, three masters)", progress):
+        man = run_manoeuvre_scenario(out / "coupled_manoeuvre", quick=quick, fmus=built["manoeuvre"])
+    res["coupled_manoeuvre_run"] = man["summary"]
     if params_file is not None:  # a user's configuration: say what the engine scenarios do not take from it
         res["engine_scenarios_note"] = (
             "the engine scenarios keep their own settings whatever --params says: the coupled run drives this "
             "configuration's contact FMU with the reference's spool schedule (a run-up through the reference's first "
-            "critical speed, 186 rad/s); the scenario with wear runs the embedded reference with its liner on")
+            "critical speed, 186 rad/s); the scenarios with wear and with a manoeuvre run the embedded reference with "
+            "its liner on")
     res["figures_extra"] = [
         ("Contact and stability maps through the FMU (quasi-static sweeps)", "fmu_quasi_static/fmu_maps.png"),
         ("Normal contact forces through the FMU, 2D vs 3D (paper Fig. 12)", "fmu_transient/fmu_contact_forces.png"),
         ("Run-up through the first critical speed through the FMU", "fmu_run_up/run_up.png"),
         *[(t, str(Path("coupled") / p)) for t, p in coupled.get("figures", [])],
         *[(t, str(Path("coupled_wear") / p)) for t, p in wear.get("figures", [])],
+        *[(t, str(Path("coupled_manoeuvre") / p)) for t, p in man.get("figures", [])],
     ]
-    return {"summary": res, "markdown": report_section(res), "verdict": verdict_lines(res)}
+    return {"summary": res, "markdown": report_section(res) + man["markdown"], "verdict": verdict_lines(res)}
 
 
 def verdict_lines(s: dict) -> list[str]:
@@ -165,6 +178,12 @@ def verdict_lines(s: dict) -> list[str]:
         lines.append(f"  engine with wear: the closing clearance cuts the liner {w['wear_depth_max_mm'] * 1e3:.3g} µm "
                      f"deep; the engine keeps {w['clearance_effective_end_mm']:.4g} mm (fmpy, libcosim, C master "
                      "agree)")
+    m = s.get("coupled_manoeuvre_run")
+    if m:
+        n = m["wear_lobes"]
+        lines.append(f"  engine in a {m['load_factor_peak']:g} g pull-up: the ovalized case is cut "
+                     f"{m['wear_depth_max_mm'] * 1e3:.3g} µm deep in {n} lobe{'s' if n != 1 else ''}; level flight "
+                     f"cuts {m['level_flight_wear_depth_max_mm'] * 1e3:.3g} µm")
     if s.get("engine_scenarios_note"):
         lines.append(f"  note: {s['engine_scenarios_note']}")
     return lines

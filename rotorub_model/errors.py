@@ -18,3 +18,8 @@ class ConvergenceError(RotorubError):
 
 class DivergenceError(RotorubError):
     """A transient run diverged; the message gives the time and the quantity."""
+
+
+class FEImportError(RotorubError, ValueError):
+    """A finite-element export cannot be imported as it is (units, dof map, matrices, tip nodes, speeds,
+    coordinates); the message names the file or the field and what is accepted. Nothing is written."""

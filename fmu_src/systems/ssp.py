@@ -30,7 +30,7 @@ import numpy as np
 
 from ..fmi.description import enumerations, read_description
 from ..fmi.variables import Var
-from .system import CLEARANCE_ID, CONNECTIONS, CONTACT_ID, G0_RUB, ME_REF, SPOOL_ID, EngineError
+from .system import CONNECTIONS, CONTACT_ID, G0_RUB, ME_REF, PARTS, SPOOL_ID, EngineError
 
 SCHEMA_DIR = Path(__file__).resolve().parent / "schemas" / "ssp1"
 NS = {
@@ -105,7 +105,7 @@ def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, 
               imbalance: float = ME_REF, formulation: str = "3D", mode: str = "transient",
               spool_params: dict | None = None, contact_params: dict | None = None, t_end: float = 5.0,
               h: float = 1e-3, name: str = "RotorRubEngine", clearance_fmu: str | Path | None = None,
-              clearance_params: dict | None = None) -> Path:
+              clearance_params: dict | None = None, parts: dict[str, tuple] | None = None) -> Path:
     """Write the coupled system as an SSP 1.0 package; returns its path.
 
     The package holds ``SystemStructure.ssd``, ``resources/RotorCasingContact.fmu``,
@@ -119,20 +119,36 @@ def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, 
     turns the spool's speed into the clearance closure the contact gets (spool.Omega -> clearance.Omega,
     clearance.closure -> contact.clearance_closure), with ``clearance_params`` in ``resources/clearance.ssv``;
     the contact then also shows its wear outputs and the clearance it keeps.
+
+    Any part of :data:`~fmu_src.systems.system.PARTS` joins the same way: ``parts`` maps its name to ``(fmu,
+    params)`` (``clearance_fmu, clearance_params`` are ``parts={"clearance": (clearance_fmu, clearance_params)}``).
+    ``casing_load`` (CasingLoad.fmu, fmu_src/models/casing_load/) drives the contact's casing_lobe2 and
+    casing_offset inputs. Each part is listed after the spool in PARTS' order, with its connections and
+    ``resources/<name>.ssv`` (its parameters' start values updated by ``params``).
     """
     path = Path(path)
+    chosen = dict(parts or {})
+    if clearance_fmu is not None:
+        if "clearance" in chosen:
+            raise EngineError("write_ssp: the clearance part given twice (clearance_fmu and parts)")
+        chosen["clearance"] = (clearance_fmu, clearance_params)
+    unknown = [n for n in chosen if n not in PARTS]
+    if unknown:
+        raise EngineError(f"write_ssp: no part named '{unknown[0]}'; known: {', '.join(PARTS)}")
+    chosen = {n: chosen[n] for n in PARTS if n in chosen}  # PARTS' order, whatever the caller's
     cvars, cunits, croot = read_description(contact_fmu)
     svars, sunits, _ = read_description(spool_fmu)
     all_units = {**sunits, **cunits}
     connections = list(CONNECTIONS)
-    if clearance_fmu is not None:
-        kvars, kunits, _ = read_description(clearance_fmu)
-        all_units = {**kunits, **all_units}
-        connections += [("spool", "Omega", "clearance", "Omega"), ("clearance", "closure", "contact",
-                                                                   "clearance_closure")]
+    part_vars = {}
+    for pname, (fmu, _params) in chosen.items():
+        pvars, punits, _ = read_description(fmu)
+        part_vars[pname] = pvars
+        all_units = {**punits, **all_units}
+        connections += PARTS[pname].connections
     for el, conn, ee, ec in connections:
         for comp, var in ((el, conn), (ee, ec)):
-            vars_ = {"contact": cvars, "spool": svars}.get(comp) or kvars
+            vars_ = {"contact": cvars, "spool": svars, **part_vars}[comp]
             if var not in vars_:
                 raise EngineError(f"write_ssp: the {comp} FMU has no variable '{var}'")
     spool_values = {k: float(v.start) for k, v in svars.items() if v.causality == "parameter"}
@@ -169,17 +185,15 @@ def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, 
          [("friction_torque", "input"), ("Omega", "output"), ("drive_torque", "output"),
           ("windage_torque", "output")]),
     ]
-    if clearance_fmu is not None:
-        comps[0][4].extend([("clearance_closure", "input"), ("wear.depth_max", "output"),
-                            ("wear.volume", "output"), ("clearance_effective", "output")])
-        clearance_values = {k: float(v.start) for k, v in kvars.items() if v.causality == "parameter"}
-        for k, v in (clearance_params or {}).items():
-            if k not in clearance_values:
-                raise EngineError(f"write_ssp: clearance parameter '{k}' unknown; known: {', '.join(clearance_values)}")
-            clearance_values[k] = float(v)
-
-        comps.append(("clearance", f"resources/{CLEARANCE_ID}.fmu", kvars, clearance_values,
-                      [("Omega", "input"), ("closure", "output")]))
+    for pname, (_fmu, params) in chosen.items():
+        part, pvars = PARTS[pname], part_vars[pname]
+        comps[0][4].extend(c for c in part.contact_connectors if c not in comps[0][4])
+        values = {k: float(v.start) for k, v in pvars.items() if v.causality == "parameter"}
+        for k, v in (params or {}).items():
+            if k not in values:
+                raise EngineError(f"write_ssp: {pname} parameter '{k}' unknown; known: {', '.join(values)}")
+            values[k] = float(v)
+        comps.append((pname, f"resources/{part.identifier}.fmu", pvars, values, list(part.connectors)))
     for cname, source, vars_, pvalues, conns in comps:
         comp = ET.SubElement(elements, _q("ssd", "Component"), name=cname, type="application/x-fmu-sharedlibrary",
                              source=source, implementation="CoSimulation")
@@ -235,9 +249,9 @@ def write_ssp(path: str | Path, contact_fmu: str | Path, spool_fmu: str | Path, 
         z.write(spool_fmu, f"resources/{SPOOL_ID}.fmu")
         z.writestr("resources/contact.ssv", _parameter_set("contact", contact_values, cvars, all_units))
         z.writestr("resources/spool.ssv", _parameter_set("spool", spool_values, svars, all_units))
-        if clearance_fmu is not None:
-            z.write(clearance_fmu, f"resources/{CLEARANCE_ID}.fmu")
-            z.writestr("resources/clearance.ssv", _parameter_set("clearance", clearance_values, kvars, all_units))
+        for pname, source, pvars, values, _conns in comps[2:]:
+            z.write(chosen[pname][0], source)
+            z.writestr(f"resources/{pname}.ssv", _parameter_set(pname, values, pvars, all_units))
     return path
 
 
@@ -397,12 +411,18 @@ def run_ssp_libcosim(ssp: str | Path, t_end: float, h: float = 1e-3,
             raise EngineError(f"run_ssp_libcosim: component '{comp}' has no variable '{var}'")
         refs[f"{comp}.{var}"] = (index[comp], *names[var])
     out = {k: np.empty(steps) for k in refs}
+    groups: dict[tuple[int, int], list[tuple[str, int]]] = {}  # one observer call per component and type
+    for key, (i, ref, typ) in refs.items():  # libcosim's variable types: 0 Real, 1 Integer
+        groups.setdefault((i, typ), []).append((key, ref))
     for k in range(steps):
         if not ex.step(1):
             raise EngineError(f"run_ssp_libcosim: step {k} (t = {k * h:g} s) failed; libcosim state "
                               f"{ex.status().state}")
-        for key, (i, ref, typ) in refs.items():  # libcosim's variable types: 0 Real, 1 Integer
-            out[key][k] = (observer.last_integer_values if typ == 1 else observer.last_real_values)(i, [ref])[0]
+        for (i, typ), items in groups.items():
+            values = (observer.last_integer_values if typ == 1 else observer.last_real_values)(
+                i, [ref for _key, ref in items])
+            for (key, _ref), v in zip(items, values):
+                out[key][k] = v
     del ex, observer
     return {"t": (np.arange(steps) + 1) * h, **out}
 
@@ -527,8 +547,10 @@ def run_ssp_fmpy(ssp: str | Path, t_end: float, h: float | None = None,
             for comp, var in record:
                 if comp not in by or var not in by[comp]["vr"]:
                     raise EngineError(f"run_ssp_fmpy: no variable {comp}.{var} in {ssp}")
-            probes = [(slaves[comp].fmu, by[comp]["vr"][var], slaves[comp].variables[var].type)
-                      for comp, var in record]
+            probes: dict[tuple[str, bool], list[tuple[int, int]]] = {}  # one get per component and type
+            for j, (comp, var) in enumerate(record):
+                probes.setdefault((comp, slaves[comp].variables[var].type == "Real"), []).append(
+                    (j, by[comp]["vr"][var]))
             out = np.empty((steps, len(record)))
             for k in range(steps):
                 values = [src.getReal([vr])[0] for src, vr, _d, _v in links]  # Jacobi: every output at t_k first
@@ -540,8 +562,9 @@ def run_ssp_fmpy(ssp: str | Path, t_end: float, h: float | None = None,
                 except FMICallException as exc:
                     msgs = [f"{n}: {msg}" for n, s in slaves.items() for msg in s.log.problems(0)]
                     raise EngineError(f"run_ssp_fmpy: step at t = {k * h:g} s refused ({exc})", msgs) from None
-                for j, (f, vr, typ) in enumerate(probes):
-                    out[k, j] = f.getReal([vr])[0] if typ == "Real" else f.getInteger([vr])[0]
+                for (comp, real), items in probes.items():
+                    f = slaves[comp].fmu
+                    out[k, [j for j, _vr in items]] = (f.getReal if real else f.getInteger)([vr for _j, vr in items])
         except FMUError as exc:
             raise EngineError(f"run_ssp_fmpy: {exc}", exc.messages) from None
         finally:

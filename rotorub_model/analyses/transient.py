@@ -54,6 +54,8 @@ from ..plotting import pyplot
 from ..structure.model import Model
 from ..writing import save_result
 
+BLOCK_MIN_DOFS = 200  # the time loop steps by blocks from this many dofs (benchmarks/bench_scale.py's crossing)
+
 
 def all_closed_stiffness(contact: ContactModel, omega: float) -> np.ndarray:
     """Contact stiffness with every blade in full contact at the law's largest slope (-dF_nl/dq) at spin omega."""
@@ -63,6 +65,12 @@ def all_closed_stiffness(contact: ContactModel, omega: float) -> np.ndarray:
 def critical_time_step(model: Model, contact: ContactModel, omega: float) -> float:
     """2 / w_max of the linearised system with all contacts closed at the law's largest slope [s]: the kernel's
     (rr_critical_step), which both FMUs call too, so all pick the same step."""
+    # the limit depends on the model, the law and the speed only (every contact closed: not on g0): kept on the
+    # contact model, so a study's runs at one speed compute it once
+    cache = contact.__dict__.setdefault("_step_limits", {})
+    key = (id(model), float(omega))
+    if key in cache and cache[key][0] is model:
+        return cache[key][1]
     n = model.n_dofs
     Minv = kernel.inverse(model.M)  # the kernel's LU, as the FMUs invert M
     Kw = np.ascontiguousarray(model.K_omega(omega))
@@ -70,6 +78,7 @@ def critical_time_step(model: Model, contact: ContactModel, omega: float) -> flo
     dt = contact.lib.rr_critical_step(contact.kernel, float(omega), kernel.ptr(Minv), kernel.ptr(Kw), kernel.ptr(work))
     if not dt > 0:
         raise ParameterError("the central-difference stability limit: the eigenvalue iteration did not converge")
+    cache[key] = (model, float(dt))
     return float(dt)
 
 
@@ -89,7 +98,7 @@ class CentralDifference:
 
     def __init__(self, model: Model, contact: ContactModel, dt: float | None = None, t_ramp: float = 1.0,
                  max_penetration: float | None = None, omega_max_for_dt: float | None = None,
-                 liner: Liner | None = None):
+                 liner: Liner | None = None, blocks: bool | None = None):
         if t_ramp is None or not math.isfinite(t_ramp) or t_ramp < 0:
             raise ParameterError(f"t_ramp: {t_ramp} out of range; accepted range [0, inf) s")
         if max_penetration is None:  # the parameter file's (contact.max_penetration: an abradable liner's depth)
@@ -97,6 +106,10 @@ class CentralDifference:
         if not math.isfinite(max_penetration) or max_penetration <= 0:
             raise ParameterError(f"max_penetration: {max_penetration} out of range; accepted range (0, inf) m")
         self.model = model
+        # the step by blocks (hub, blades, casing) where the model is large enough for it to pay: its cost grows
+        # linearly with the blades, the dense step's as their square (another order of sums: not the dense step's
+        # bits, so the reference's 38 dofs keep the dense step)
+        self.blocks = (model.n_dofs >= BLOCK_MIN_DOFS) if blocks is None else bool(blocks)
         self.user_dt = dt
         w = omega_max_for_dt if omega_max_for_dt is not None else 0.0
         self.dt_limit = critical_time_step(model, contact, w)
@@ -108,7 +121,7 @@ class CentralDifference:
         # one kernel job, kept: a call only changes what differs from the last one; the job keeps the contact
         # evaluation of its last state, so that a run cut into calls (held inputs) evaluates each state once
         self._job = kernel.RRJob(state=ctypes.addressof(self._s), t_ramp=float(t_ramp))
-        self._cache = np.zeros(contact.lib.rr_cd_cache_size(n, contact.n_blades, contact.n_points))
+        self._cache = np.zeros(contact.lib.rr_cd_cache_size(n, contact.n_segments, contact.n_points))
         self._job.cache = kernel.ptr(self._cache)
         self._job_ref = ctypes.byref(self._job)
         self._bound: tuple = ()
@@ -180,22 +193,42 @@ class CentralDifference:
         key = (omega, omega_dot, self.dt)
         if key != self._key:
             m, n = self.model, self.model.n_dofs
-            Ainv, K2, Cm1 = np.empty((n, n)), np.empty((n, n)), np.empty((n, n))
-            work, piv = np.empty(2 * n * n), np.empty(n, dtype=np.intc)  # named: alive during the call
+            lib = self.contact.lib
             structure = [np.ascontiguousarray(getattr(m, k), dtype=float)
                          for k in ("M", "D", "K", "G1", "C1", "N2", "S2", "E1")]
-            # assembled and inverted by the kernel: the FMUs build the same matrices with the same code
-            if self.contact.lib.rr_cd_build(
-                    n, *map(kernel.ptr, structure), float(omega), float(omega_dot), float(self.dt), kernel.ptr(Ainv),
-                    kernel.ptr(K2), kernel.ptr(Cm1), kernel.ptr(work), kernel.iptr(piv)) != 0:
-                raise ParameterError(f"dt: {self.dt:g} s: the central-difference matrix is singular")
+            s4 = None if m.S4 is None else np.ascontiguousarray(m.S4, dtype=float)
+            s4p = None if s4 is None else kernel.ptr(s4)
             # the imbalance force per unit m e (scaled by the kernel) and the blades' own inertia
             # load under dOmega/dt (not scaled: it does not depend on the imbalance)
-            f_me = omega * omega * m.f_unit + omega_dot * m.f_tangential
-            f0 = omega_dot * m.f_euler
-            arrays = (Ainv, K2, Cm1, np.ascontiguousarray(f_me, dtype=float), np.ascontiguousarray(f0, dtype=float))
-            mats = kernel.RRMatrices(n, *map(kernel.ptr, arrays))
-            self._mats = (mats, arrays)
+            f_me = np.ascontiguousarray(omega * omega * m.f_unit + omega_dot * m.f_tangential, dtype=float)
+            f0 = np.ascontiguousarray(omega_dot * m.f_euler, dtype=float)
+            layout = m.block_layout if self.blocks else None
+            if layout is not None:
+                # by blocks (hub, blades, casing): a step's cost grows linearly with the blades (rr_cd_blocks)
+                ns, nb, mb, nc = layout
+                store = np.zeros(lib.rr_cd_blocks_size(ns, nb, mb, nc))
+                work = np.zeros(lib.rr_cd_blocks_work_size(ns, mb, nc))
+                piv = np.zeros(max(ns, mb, nc), dtype=np.intc)
+                blocks = kernel.RRBlocks()
+                if lib.rr_cd_build_blocks(n, ns, nb, mb, nc, *map(kernel.ptr, structure), s4p, float(omega),
+                                          float(omega_dot), float(self.dt), kernel.ptr(store), ctypes.byref(blocks),
+                                          kernel.ptr(work), kernel.iptr(piv)) != 0:
+                    raise ParameterError(f"dt: {self.dt:g} s: a block of the central-difference matrix is singular")
+                arrays = (store, f_me, f0)
+                mats = kernel.RRMatrices(n=n, f=kernel.ptr(f_me), f0=kernel.ptr(f0),
+                                         blocks=ctypes.addressof(blocks))
+                self._mats = (mats, arrays, blocks)
+            else:
+                Ainv, K2, Cm1 = np.empty((n, n)), np.empty((n, n)), np.empty((n, n))
+                work, piv = np.empty(2 * n * n), np.empty(n, dtype=np.intc)  # named: alive during the call
+                # assembled and inverted by the kernel: the FMUs build the same matrices with the same code
+                if lib.rr_cd_build(
+                        n, *map(kernel.ptr, structure), s4p, float(omega), float(omega_dot), float(self.dt),
+                        kernel.ptr(Ainv), kernel.ptr(K2), kernel.ptr(Cm1), kernel.ptr(work), kernel.iptr(piv)) != 0:
+                    raise ParameterError(f"dt: {self.dt:g} s: the central-difference matrix is singular")
+                arrays = (Ainv, K2, Cm1, f_me, f0)
+                mats = kernel.RRMatrices(n, *map(kernel.ptr, arrays))
+                self._mats = (mats, arrays)
             self._job.mats = ctypes.addressof(mats)
             self._key = key
         return self._mats[0]

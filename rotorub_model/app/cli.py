@@ -485,6 +485,37 @@ def cmd_reproduce(ns: argparse.Namespace) -> Done:
     return Done(s, main_job_verdict(s, ns.out, fmu_lines, fmu=not ns.no_fmu))
 
 
+@command("import-blade", "read a finite-element blade (CalculiX, Matrix Market, NASTRAN OP4/DMIG), reduce it once, "
+         "check it against the FE code and write the superelement a parameter file names")
+@arg("--fe", nargs="+", required=True, help="CalculiX jobs (one a speed, the first at rest), or a Matrix Market mass "
+     "then stiffness files, or an .op4 / DMIG .pch file with --matrices")
+@arg("--units", required=True, help="the files' unit system, e.g. SI, N-mm-t-s, mN-mm-kg-s, kN-mm-kg-ms, lbf-in-s")
+@arg("--tip-nodes", nargs="+", required=True, help="ids of the contact nodes along the tip, or a file of ids")
+@arg("--coordinates", default=None, help="node coordinates: .inp, .msh, NASTRAN GRIDs, or 'id x y z' table")
+@arg("--speeds", nargs="+", type=float, default=None, help="spin speed of each stiffness [rad per time unit] "
+     "(CalculiX jobs: read from their decks)")
+@arg("--dofs", default=None, help="dof map of the stiffness rows (Matrix Market, OP4)")
+@arg("--mass-dofs", default=None, help="dof map of the mass rows when it has more (the root's, constrained dofs)")
+@arg("--matrices", nargs="+", default=None, help="OP4/DMIG matrix names: the mass, then one stiffness a speed")
+@arg("--mass-free", default=None, help="CalculiX job of the unclamped blade (its mass rows hold the root's)")
+@arg("--cutoff-hz", type=float, default=1500.0, help="keep the blade modes below this frequency")
+@arg("--basis", default="condensed", help="condensed (default), modal or two-speed")
+@arg("--axis-origin", nargs=3, type=float, default=(0.0, 0.0, 0.0), help="a point of the spin axis at the fan "
+     "disk's station (file units)")
+@arg("--axis-direction", nargs=3, type=float, default=(0.0, 0.0, 1.0), help="the spin axis (file axes)")
+@arg("--compare-reductions", action="store_true", default=None, help="measure every reduction (step, accuracy, "
+     "cost) even above 20 000 dofs")
+def cmd_import_blade(ns: argparse.Namespace) -> dict:
+    from ..fe.import_blade import import_blade_command
+
+    p = load_parameters(ns.params)
+    return import_blade_command(
+        ns.fe, ns.units, ns.tip_nodes, ns.out, coordinates=ns.coordinates, speeds=ns.speeds, dofs=ns.dofs,
+        mass_dofs=ns.mass_dofs, matrices=ns.matrices, mass_free=ns.mass_free, cutoff_hz=ns.cutoff_hz,
+        basis=ns.basis, axis_origin=ns.axis_origin, axis_direction=ns.axis_direction, k_r=p.contact.k_r,
+        damping_ratio=p.blades.damping_ratio, variants=ns.compare_reductions)
+
+
 class _OneLineParser(argparse.ArgumentParser):
     """argparse that reports a bad argument on one line (no usage dump)."""
 

@@ -83,7 +83,9 @@ class ContactModel:
 
     def __post_init__(self) -> None:
         g = self.geometry
-        self.n_blades, self.n_points = g.points.shape[:2]
+        # the kernel's 'blades' (an imported tip's segments) and the blades the outputs report
+        self.n_segments, self.n_points = g.points.shape[:2]
+        self.n_blades = g.tips.n_blades if g.tips is not None else self.n_segments
         self.G, self.A, self.B, self.S = g.G, g.A, g.B, g.S
         self._k = None
 
@@ -93,14 +95,27 @@ class ContactModel:
         """The kernel's rr_contact struct of this model (its arrays are pinned on the object)."""
         if self._k is None:
             g = self.geometry
+            names = ("G", "A", "B", "S", "points", "normals", "tangents", "T2")
             arrays = [np.ascontiguousarray(a, dtype=float) for a in (
                 self.G, self.A, self.B, self.S, g.points, g.normals, g.tangents, g.disk)]
             self._lib = kernel.load()
-            work = np.zeros(self._lib.rr_work_size(self.n_dofs, self.n_blades, self.n_points))
-            self._pinned = (*arrays, work)
-            self._k = kernel.RRContact(self.n_dofs, self.n_blades, self.n_points, float(self.g0), float(self.k_r),
-                                       float(self.mu), float(max(self.geometry.chord, 1e-300)), float(self.v_slip),
-                                       law_record(self.law, self.law_params), *map(kernel.ptr, self._pinned))
+            work = np.zeros(self._lib.rr_work_size(self.n_dofs, self.n_segments, self.n_points))
+            fields = {k: kernel.ptr(a) for k, a in zip(names, arrays)}
+            pinned = [*arrays, work]
+            t = g.tips
+            if t is not None:  # an imported tip: its segments, compact rows, the blades its outputs report
+                tip_f = [np.ascontiguousarray(a, dtype=float) for a in (t.seg_len, t.seg_k, t.g_off, t.point_share)]
+                tip_i = [np.ascontiguousarray(a, dtype=np.intc) for a in (t.cols, t.blade_of, t.point_row)]
+                pinned += tip_f + tip_i
+                fields.update({k: kernel.ptr(a) for k, a in zip(("seg_len", "seg_k", "g_off", "point_share"),
+                                                                 tip_f)})
+                fields.update({k: kernel.iptr(a) for k, a in zip(("cols", "blade_of", "point_row"), tip_i)})
+                fields.update(nloc=int(t.cols.shape[1]), nb_out=int(t.n_blades), n_rows=int(t.n_rows))
+            self._pinned = tuple(pinned)
+            self._k = kernel.RRContact(n=self.n_dofs, nb=self.n_segments, np=self.n_points, g0=float(self.g0),
+                                       k_r=float(self.k_r), mu=float(self.mu),
+                                       chord=float(max(self.geometry.chord, 1e-300)), v_slip=float(self.v_slip),
+                                       law=law_record(self.law, self.law_params), work=kernel.ptr(work), **fields)
         return self._k
 
     @property
@@ -111,13 +126,20 @@ class ContactModel:
 
     def __getstate__(self) -> dict:
         # ctypes objects do not pickle: a copy in another process builds its own view
-        state = {k: v for k, v in self.__dict__.items() if k not in ("_k", "_pinned", "_lib")}
+        state = {k: v for k, v in self.__dict__.items() if k not in ("_k", "_pinned", "_lib", "_step_limits")}
         state["_k"] = None
         return state
 
     @property
     def n_dofs(self) -> int:
-        return self.G.shape[1]
+        t = self.geometry.tips
+        return t.n_dofs if t is not None else self.G.shape[1]
+
+    @property
+    def n_rows(self) -> int:
+        """Rows of the liner's worn depth: the points of a blade, or an imported tip's chord stations."""
+        t = self.geometry.tips
+        return t.n_rows if t is not None else self.n_points
 
     @property
     def n_outputs(self) -> int:
@@ -131,18 +153,20 @@ class ContactModel:
 
     def _eval(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         q = np.ascontiguousarray(q, dtype=float)
-        gaps = np.empty((self.n_blades, self.n_points))
-        law = np.empty((self.n_blades, kernel.LAW_WIDTH))
+        gaps = np.empty((self.n_segments, self.n_points))
+        law = np.empty((self.n_segments, kernel.LAW_WIDTH))
         k = self.kernel
         self._lib.rr_laws(k, kernel.ptr(q), kernel.ptr(gaps), kernel.ptr(law))
         return gaps, law
 
     def gaps(self, q: np.ndarray) -> np.ndarray:
-        """Gaps (N, P) [m]: tip (2D) or LE, TE (3D); negative = penetration."""
+        """Gaps (N, P) [m]: tip (2D) or LE, TE (3D); negative = penetration (an imported tip: per segment, its two
+        stations)."""
         return self._eval(q)[0]
 
     def laws(self, q: np.ndarray) -> np.ndarray:
-        """Per blade (N, 8): F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction, potential [J]."""
+        """Per blade (N, 8): F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction, potential [J] (an
+        imported tip: per segment)."""
         return self._eval(q)[1]
 
     @staticmethod
@@ -153,7 +177,7 @@ class ContactModel:
         """mu tanh(v_p / v_slip) at every contact point (N, P) (0 where the blade does not touch);
         ``qdot`` None: the state is at rest in the rotating frame (a static solution)."""
         q, qd = np.ascontiguousarray(q, dtype=float), self._velocity(qdot)
-        fr = np.empty((self.n_blades, self.n_points))
+        fr = np.empty((self.n_segments, self.n_points))
         k = self.kernel
         self._lib.rr_friction(k, kernel.ptr(q), None if qd is None else kernel.ptr(qd), float(omega), kernel.ptr(fr))
         return fr
@@ -166,7 +190,13 @@ class ContactModel:
         rho = g.points[..., 0] * g.tangents[..., 1] - g.points[..., 1] * g.tangents[..., 0]
         v = omega * rho
         if qdot is not None:
-            v = v + (self.S @ np.asarray(qdot, dtype=float)).reshape(self.n_blades, self.n_points)
+            qd = np.asarray(qdot, dtype=float)
+            t = g.tips
+            if t is None:
+                v = v + (self.S @ qd).reshape(self.n_segments, self.n_points)
+            else:  # compact rows: each segment's over its own columns
+                S = self.S.reshape(self.n_segments, self.n_points, -1)
+                v = v + np.einsum("spk,sk->sp", S, qd[t.cols])
         return v
 
     def forces(self, q: np.ndarray, omega: float, qdot: np.ndarray | None = None) -> np.ndarray:
@@ -200,7 +230,7 @@ class ContactModel:
         """The law's strain energy, summed over the blades, of states given by their gaps (m, N, P) [J] (the
         kernel's; its gradient is -F_nl without friction). Gaps rather than states: a run against a worn liner
         records its gaps to the worn surface, which gaps(q) does not know."""
-        g = np.ascontiguousarray(np.asarray(gaps, dtype=float).reshape(-1, self.n_blades * self.n_points))
+        g = np.ascontiguousarray(np.asarray(gaps, dtype=float).reshape(-1, self.n_segments * self.n_points))
         out = np.empty(g.shape[0])
         self.lib.rr_potential_batch(self.kernel, int(g.shape[0]), kernel.ptr(g), kernel.ptr(out))
         return out
@@ -219,14 +249,17 @@ class ContactModel:
     def gaps_batch(self, Q: np.ndarray) -> np.ndarray:
         """Gaps of many states Q (m, n): (m, N, P)."""
         Q = np.ascontiguousarray(Q, dtype=float)
-        out = np.empty((Q.shape[0], self.n_blades, self.n_points))
+        out = np.empty((Q.shape[0], self.n_segments, self.n_points))
         k = self.kernel
         self._lib.rr_gaps_batch(k, int(Q.shape[0]), kernel.ptr(Q), kernel.ptr(out))
         return out
 
     def blade_forces(self, q: np.ndarray, omega: float, qdot: np.ndarray | None = None) -> dict[str, np.ndarray]:
         """Per-blade outputs: F_N, F_T (friction, positive against the spin), M_N, M_T [N, N m],
-        gaps, chord fraction in contact."""
+        gaps, chord fraction in contact (an imported tip: its segments' sums; the gaps are its leading and trailing
+        stations', the moments about the tip's mid-chord)."""
+        if self.geometry.tips is not None:
+            return self._tip_forces(q, omega, qdot)
         g, L = self._eval(q)
         fr = self.friction_factors(q, omega, qdot)
         w = self._weights(L)
@@ -240,11 +273,31 @@ class ContactModel:
             "fraction": L[:, 6].copy(),
         }
 
+    def _tip_forces(self, q: np.ndarray, omega: float, qdot: np.ndarray | None) -> dict[str, np.ndarray]:
+        t = self.geometry.tips
+        o = self.split_outputs(self.outputs_array(q, omega, None if qdot is None else np.atleast_2d(qdot)))
+        g, L = self._eval(q)
+        fr = self.friction_factors(q, omega, qdot)
+        w = self._weights(L)
+        # each point's chord coordinate, from the tip's mid-chord (segments laid end to end from the leading edge)
+        starts = np.zeros(self.n_segments)
+        for b in range(t.n_blades):
+            s = np.flatnonzero(t.blade_of == b)
+            edges = np.concatenate([[0.0], np.cumsum(t.seg_len[s])])
+            starts[s] = edges[:-1] - 0.5 * edges[-1]
+        arm = np.stack([starts, starts + t.seg_len], axis=1)
+        M_N = np.bincount(t.blade_of, weights=(w * arm).sum(axis=1), minlength=t.n_blades)
+        M_T = np.bincount(t.blade_of, weights=(fr * w * arm).sum(axis=1), minlength=t.n_blades)
+        return {"F_N": o["F_N"][0], "F_T": o["F_T"][0], "M_N": M_N, "M_T": M_T, "gap": o["gap"][0],
+                "fraction": o["fraction"][0]}
+
     def _weights(self, L: np.ndarray) -> np.ndarray:
         """Point weights w_p (N, P) of the laws L: the normal force each point carries."""
         FN, MN = L[:, 0], L[:, 1]
         if self.n_points == 2:
-            return np.stack([0.5 * FN - MN / self.geometry.chord, 0.5 * FN + MN / self.geometry.chord], axis=1)
+            t = self.geometry.tips
+            chord = self.geometry.chord if t is None else t.seg_len
+            return np.stack([0.5 * FN - MN / chord, 0.5 * FN + MN / chord], axis=1)
         return FN[:, None].copy()
 
     def outputs_array(self, Q: np.ndarray, omega: float, Qdot: np.ndarray | None = None) -> np.ndarray:
@@ -336,6 +389,13 @@ def make_contact(model: Model, formulation: str = "3D", variant: str = "full", *
         c = model.params.replace(contact=overrides).contact
     if formulation == "2D":
         geo = geometry_2d(model)
+    elif getattr(model, "fe_blade", None) is not None:  # an imported blade: its tip's chord stations
+        if variant != "full":
+            raise ParameterError(f"variant: '{variant}' is the paper's study of its beam blades; accepted with an "
+                                 "imported blade: full")
+        from .fe_tip import geometry_fe
+
+        geo = geometry_fe(model, np.radians(c.theta_deg), model.params.fe_blade.stations)
     else:
         theta, chord = np.radians(c.theta_deg), c.chord
         if variant == "kinematics_only":

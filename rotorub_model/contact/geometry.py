@@ -21,8 +21,28 @@ from ..structure.model import Model
 
 
 @dataclass
+class TipLayout:
+    """An imported blade's tip (docs/THEORY.md 9): its chord stations joined by segments, each segment a 'blade'
+    of the kernel (two points: its leading and trailing station) with the chord law of its own length. The rows
+    G, A, B, S of the geometry are then compact: segment j's columns are the dofs ``cols[j]`` (the shaft's, its
+    blade's, the casing's), so a contact evaluation costs what the segments touch, not segments x every dof."""
+
+    n_blades: int  # the blades the outputs report
+    n_dofs: int
+    seg_len: np.ndarray  # (S,) each segment's chord length [m]
+    seg_k: np.ndarray  # (S,) its share of k_r (and of the liner's yield force): its length over the tip's chord
+    g_off: np.ndarray  # (S*2,) each point's rest gap beyond g0 [m] (a tip that is not cut to the casing's line)
+    cols: np.ndarray  # (S, nloc) intc: the dofs of segment j's rows
+    blade_of: np.ndarray  # (S,) intc: each segment's blade, ascending, its segments from the leading edge
+    n_rows: int  # rows of the liner's worn depth: the tip's stations
+    point_row: np.ndarray  # (S*2,) intc: each point's station
+    point_share: np.ndarray  # (S*2,) the liner's share of each point (its station's tributary chord; 0: a twin)
+
+
+@dataclass
 class ContactGeometry:
-    """Per-point geometry: arrays of shape (N, P, ...) with P = 1 (2D) or 2 (LE, TE)."""
+    """Per-point geometry: arrays of shape (N, P, ...) with P = 1 (2D) or 2 (LE, TE); for an imported blade's tip
+    (``tips``), N is its segments' count and the rows are compact (TipLayout)."""
 
     points: np.ndarray  # (N, P, 3) rest positions, rotating frame, z from the blade-tip plane
     normals: np.ndarray  # (N, P, 3) outward casing normal
@@ -35,6 +55,7 @@ class ContactGeometry:
     A: np.ndarray  # (N, n) d eta / dq (mean gap along the chord)
     B: np.ndarray  # (N, n) d zeta / dq (gap slope)
     S: np.ndarray  # (N*P, n) sliding rows e_t . (J_b - J_c): relative sliding along e_t = S q
+    tips: TipLayout | None = None  # an imported blade's tip: segments, compact rows
 
 
 def geometry_spec(model: Model, n_points: int, theta: float, chord: float, rotations: bool) -> dict:

@@ -73,8 +73,8 @@ class Liner:
             raise ParameterError(f"liner n_sectors: {self.n_sectors!r} out of range; accepted range [8, 100000]")
         c = self.contact
         lib = c.lib
-        self._tables = np.zeros(lib.rr_surface_table_size(c.n_blades, c.n_points, int(self.n_sectors)))
-        self.depth = np.zeros((c.n_points, int(self.n_sectors)))
+        self._tables = np.zeros(lib.rr_surface_table_size(c.n_segments, c.n_points, int(self.n_sectors)))
+        self.depth = np.zeros((c.n_rows, int(self.n_sectors)))
         self.struct = kernel.RRSurface(n_sectors=int(self.n_sectors), wears=int(bool(self.wears)),
                                        yield_force=float(self.yield_force), hardening=float(self.hardening),
                                        thickness=float(self.thickness), tables=kernel.ptr(self._tables),

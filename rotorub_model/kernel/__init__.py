@@ -35,7 +35,7 @@ HEADER = HERE / "rotorub_kernel.h"
 INTERNAL_HEADER = HERE / "rr_internal.h"  # declarations shared by the sources, exported by none
 MATH_HEADER = HERE / "rr_math.h"  # the elementary functions: the same bits on every platform
 HEADERS = (HEADER, INTERNAL_HEADER, MATH_HEADER, HERE / "rr_batch.h")
-ABI_VERSION = 8
+ABI_VERSION = 9
 LAW_WIDTH = 8  # F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction, potential
 OUT_BLADE_BLOCKS = 6
 OUT_GLOBALS = 8
@@ -62,7 +62,12 @@ class RRLaw(ctypes.Structure):
 class RRContact(ctypes.Structure):
     _fields_ = [("n", ctypes.c_int), ("nb", ctypes.c_int), ("np", ctypes.c_int), ("g0", ctypes.c_double),
                 ("k_r", ctypes.c_double), ("mu", ctypes.c_double), ("chord", ctypes.c_double),
-                ("v_slip", ctypes.c_double), ("law", RRLaw), ("G", _dp), ("A", _dp), ("B", _dp), ("S", _dp),
+                ("v_slip", ctypes.c_double), ("law", RRLaw),
+                # imported blades' tips (segments between chord stations): NULL / 0 for the built-in blades
+                ("seg_len", _dp), ("seg_k", _dp), ("g_off", _dp), ("nloc", ctypes.c_int), ("cols", _ip),
+                ("nb_out", ctypes.c_int), ("blade_of", _ip), ("n_rows", ctypes.c_int), ("point_row", _ip),
+                ("point_share", _dp),
+                ("G", _dp), ("A", _dp), ("B", _dp), ("S", _dp),
                 ("points", _dp), ("normals", _dp), ("tangents", _dp), ("T2", _dp), ("work", _dp),
                 ("surface", ctypes.c_void_p)]
 
@@ -98,8 +103,17 @@ class RRGeometry(ctypes.Structure):
     _fields_ = [(name, _dp) for name in ("points", "normals", "tangents", "Jb", "Jc", "G", "A", "B", "S", "T2")]
 
 
+class RRBlocks(ctypes.Structure):
+    """The step's matrices by blocks (rotorub_kernel.h rr_cd_blocks): hub, blades of m dofs, casing."""
+
+    _fields_ = [("ns", ctypes.c_int), ("nb", ctypes.c_int), ("m", ctypes.c_int), ("nc", ctypes.c_int),
+                *[(k, _dp) for k in ("K2_hh", "K2_hb", "K2_bh", "K2_bb", "K2_cc", "C_hh", "C_hb", "C_bh", "C_bb",
+                                     "C_cc", "A_hb", "Binv", "W", "Sinv", "Cinv")]]
+
+
 class RRMatrices(ctypes.Structure):
-    _fields_ = [("n", ctypes.c_int), ("Ainv", _dp), ("K2", _dp), ("Cm1", _dp), ("f", _dp), ("f0", _dp)]
+    _fields_ = [("n", ctypes.c_int), ("Ainv", _dp), ("K2", _dp), ("Cm1", _dp), ("f", _dp), ("f0", _dp),
+                ("blocks", ctypes.c_void_p)]
 
 
 class RRState(ctypes.Structure):
@@ -163,7 +177,7 @@ def _declare(lib: ctypes.CDLL) -> ctypes.CDLL:
     lib.rr_inverse.restype = ctypes.c_int
     lib.rr_eigenvalues.argtypes = [ctypes.c_int, _dp, _dp, _dp, _dp]
     lib.rr_eigenvalues.restype = ctypes.c_int
-    lib.rr_cd_build.argtypes = [ctypes.c_int, *[_dp] * 8, ctypes.c_double, ctypes.c_double, ctypes.c_double,
+    lib.rr_cd_build.argtypes = [ctypes.c_int, *[_dp] * 9, ctypes.c_double, ctypes.c_double, ctypes.c_double,
                                 _dp, _dp, _dp, _dp, _ip]
     lib.rr_cd_build.restype = ctypes.c_int
     lib.rr_static_work_size.argtypes = [ctypes.c_int]
@@ -185,13 +199,20 @@ def _declare(lib: ctypes.CDLL) -> ctypes.CDLL:
     lib.rr_law_max_slope.restype = ctypes.c_double
     lib.rr_potential_batch.argtypes = [c, ctypes.c_int, _dp, _dp]
     lib.rr_closed_stiffness.argtypes = [c, ctypes.c_double, _dp]
-    lib.rr_k_omega.argtypes = [ctypes.c_int, _dp, _dp, _dp, _dp, ctypes.c_double, _dp]
+    lib.rr_k_omega.argtypes = [ctypes.c_int, _dp, _dp, _dp, _dp, _dp, ctypes.c_double, _dp]
     lib.rr_critical_step.argtypes = [c, ctypes.c_double, _dp, _dp, _dp]
     lib.rr_critical_step.restype = ctypes.c_double
     lib.rr_critical_step_work_size.argtypes = [ctypes.c_int]
     lib.rr_critical_step_work_size.restype = ctypes.c_int
     lib.rr_cd_cache_size.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_int]
     lib.rr_cd_cache_size.restype = ctypes.c_int
+    lib.rr_cd_blocks_size.argtypes = [ctypes.c_int] * 4
+    lib.rr_cd_blocks_size.restype = ctypes.c_int
+    lib.rr_cd_blocks_work_size.argtypes = [ctypes.c_int] * 3
+    lib.rr_cd_blocks_work_size.restype = ctypes.c_int
+    lib.rr_cd_build_blocks.argtypes = [ctypes.c_int] * 5 + [_dp] * 9 + [ctypes.c_double] * 3 + [
+        _dp, ctypes.c_void_p, _dp, _ip]
+    lib.rr_cd_build_blocks.restype = ctypes.c_int
     lib.rr_laws.argtypes = [c, _dp, _dp, _dp]
     lib.rr_friction.argtypes = [c, _dp, _dp, ctypes.c_double, _dp]
     lib.rr_force.argtypes = [c, _dp, _dp, ctypes.c_double, _dp]
@@ -302,12 +323,14 @@ def liner_law(g: float, k: float, fy: float, h: float, thickness: float, depth: 
     return f, d.value, w.value
 
 
-def k_omega(K: np.ndarray, S2: np.ndarray, N2: np.ndarray, C1: np.ndarray, omega: float) -> np.ndarray:
-    """The kernel's K(Omega) = K + Omega^2 (S2 + N2) + Omega C1 (the FMUs' and the time loop's bits)."""
+def k_omega(K: np.ndarray, S2: np.ndarray, N2: np.ndarray, C1: np.ndarray, omega: float,
+            S4: np.ndarray | None = None) -> np.ndarray:
+    """The kernel's K(Omega) = K + Omega^2 (S2 + N2) + Omega C1 (+ Omega^4 S4) (the FMUs' and the time loop's bits)."""
     n = K.shape[0]
     arrays = [np.ascontiguousarray(a, dtype=float) for a in (K, S2, N2, C1)]
+    s4 = None if S4 is None else np.ascontiguousarray(S4, dtype=float)
     out = np.empty((n, n))
-    load().rr_k_omega(n, *map(ptr, arrays), float(omega), ptr(out))
+    load().rr_k_omega(n, *map(ptr, arrays), None if s4 is None else ptr(s4), float(omega), ptr(out))
     return out
 
 

@@ -50,7 +50,7 @@ extern "C" {
 #endif
 
 /* Bumped whenever a struct layout or a signature below changes. */
-#define RR_ABI_VERSION 8
+#define RR_ABI_VERSION 9
 
 /* Per-blade law values (rr_laws): F_N, M_N, dF/deta, dF/dzeta, dM/deta, dM/dzeta, chord fraction, potential. */
 #define RR_LAW_WIDTH 8
@@ -96,7 +96,7 @@ enum {
 enum { RR_FN_SIN, RR_FN_COS, RR_FN_TAN, RR_FN_ATAN2, RR_FN_TANH, RR_FN_EXP, RR_FN_SQRT, RR_FN_FLOOR, RR_FN_CEIL };
 RR_API void rr_elementary(int fn, int m, const double *x, const double *y, double *out);
 
-/* number of outputs of a state for nb blades */
+/* number of outputs of a state for nb reported blades (rr_contact.nb_out, or nb) */
 #define RR_N_OUT(nb) (RR_OUT_BLADE_BLOCKS * (nb) + RR_OUT_GLOBALS)
 
 /* The casing's inner surface as the engine and a rub leave it (docs/THEORY.md, "Abradable liner"): an
@@ -152,6 +152,20 @@ typedef struct {
     double chord;     /* chord length l_c [m] (any positive value for np = 1) */
     double v_slip;    /* velocity scale of the friction regularisation tanh(v / v_slip) [m/s] (> 0) */
     rr_law law;       /* the normal law (RR_LAW_PENALTY: the paper's) */
+    /* Imported blades (docs/THEORY.md 9): a tip is a chain of chord stations, and each 'blade' of this struct is
+     * a segment between two consecutive stations (np = 2: its leading and trailing end), with the chord law of
+     * its own length over it; NULL / 0 for the built-in blades (one chord per blade, dense rows): */
+    const double *seg_len;  /* (nb) each segment's chord length [m] (NULL: chord) */
+    const double *seg_k;    /* (nb) each segment's share of k_r and of the liner's yield force (NULL: 1) */
+    const double *g_off;    /* (nb*np) each point's rest gap beyond g0 [m] (NULL: 0) */
+    int nloc;               /* > 0: every row below is stored compact, nloc columns, */
+    const int *cols;        /* (nb, nloc) the dofs of segment j's rows (NULL: dense rows of n columns) */
+    int nb_out;             /* blades the outputs report (0: nb) */
+    const int *blade_of;    /* (nb) each segment's reported blade, ascending, its segments leading edge first */
+    int n_rows;             /* rows of the casing surface's worn depth (0: np) */
+    const int *point_row;   /* (nb*np) each point's row of the surface (NULL: its index within its blade) */
+    const double *point_share; /* (nb*np) each point's share of a tip for the liner's law (its stations' tributary
+                                * chord; 0 for a station's second point, which is its twin's; NULL: 1/np) */
     const double *G;  /* (nb*np, n) gap gradients: gap = g0 + G q */
     const double *A;  /* (nb, n) d eta / dq   (mean gap along the chord) */
     const double *B;  /* (nb, n) d zeta / dq  (gap slope along the chord) */
@@ -199,6 +213,22 @@ typedef struct {
     double *T2;       /* (2, n) fan-disk translation */
 } rr_geometry;
 
+/* The step's matrices by blocks, for a model whose dofs are a hub (the shaft: ns), nb blades of m dofs each that
+ * couple to the hub only, and a casing (nc) that couples to nothing but through contact: n = ns + nb m + nc. Then
+ * 2M/dt^2 - K and M/dt^2 - C/2dt are arrows (hub-hub, hub-blade, blade-hub, blade-blade blocks, the casing's) and
+ * (M/dt^2 + C/2dt) q = r is solved by the Schur complement on the hub: a step costs nb (m^2 + 3 m ns) + ns^2 +
+ * nc^2, linear in the blades, where the dense step costs n^2 (imported blades, docs/THEORY.md 9). */
+typedef struct {
+    int ns, nb, m, nc;
+    const double *K2_hh, *K2_hb, *K2_bh, *K2_bb, *K2_cc; /* 2M/dt^2 - K: (ns,ns), (nb,ns,m), (nb,m,ns), (nb,m,m), (nc,nc) */
+    const double *C_hh, *C_hb, *C_bh, *C_bb, *C_cc;      /* M/dt^2 - C/2dt, the same blocks */
+    const double *A_hb;  /* (nb, ns, m) the hub-blade blocks of A = M/dt^2 + C/2dt */
+    const double *Binv;  /* (nb, m, m) A_bb_j^-1 */
+    const double *W;     /* (nb, m, ns) A_bb_j^-1 A_bh_j */
+    const double *Sinv;  /* (ns, ns) (A_hh - sum_j A_hb_j A_bb_j^-1 A_bh_j)^-1 */
+    const double *Cinv;  /* (nc, nc) A_cc^-1 */
+} rr_cd_blocks;
+
 /* Central-difference matrices at one (Omega, dt): (M/dt^2 + C/2dt)^-1, 2M/dt^2 - K, M/dt^2 - C/2dt. */
 typedef struct {
     int n;
@@ -207,6 +237,7 @@ typedef struct {
     const double *Cm1;   /* (n, n) */
     const double *f;     /* (n) imbalance force per unit m e [N / (kg m)] */
     const double *f0;    /* (n) load independent of the imbalance (blade inertia under dOmega/dt) [N], or NULL */
+    const rr_cd_blocks *blocks; /* the same matrices by blocks (then Ainv, K2, Cm1 are not read), or NULL */
 } rr_cd_matrices;
 
 /* State of the two-step scheme. q and q_prev are owned by the caller. */
@@ -369,10 +400,11 @@ RR_API int rr_static_solve(const rr_contact *c, double omega, const double *K, c
 RR_API int rr_static_newton(const rr_contact *c, double omega, const double *K, const double *F, double tol,
                             int max_iter, double *q, double *residual, int *iterations, double *work, int *iwork);
 
-/* K(Omega) = K0 + omega^2 (S2 + N2) + omega C1 (n x n), in that order of operations (the library's matrices,
+/* K(Omega) = K0 + omega^2 (S2 + N2) + omega C1 (+ omega^4 S4, an imported blade's; S4 NULL for the built-in) (n x n),
+ * in that order of operations (the library's matrices,
  * the FMUs' and the time loop's are the same bits). */
-RR_API void rr_k_omega(int n, const double *K0, const double *S2, const double *N2, const double *C1, double omega,
-                       double *out);
+RR_API void rr_k_omega(int n, const double *K0, const double *S2, const double *N2, const double *C1, const double *S4,
+                       double omega, double *out);
 /* The explicit central-difference stability limit 2 / omega_max at spin omega: omega_max^2 the largest |eigenvalue|
  * of Minv (Kw + Kc), Kw = K(omega), Kc = rr_closed_stiffness (every blade closed at the law's largest slope).
  * work: 2 n*n + 3 n doubles. Returns the limit [s], or -1 if the eigenvalue iteration failed. */
@@ -381,12 +413,24 @@ RR_API int rr_critical_step_work_size(int n);
 
 /* The central-difference matrices at spin speed omega, angular acceleration omega_dot and step dt,
  * assembled in the library's order of operations: C = D + omega G1,
- * K = K0 + omega^2 (S2 + N2) + omega C1 + omega_dot E1 (E1 may be NULL),
+ * K = K0 + omega^2 (S2 + N2) + omega C1 + omega_dot E1 (+ omega^4 S4; E1, S4 may be NULL),
  * Ainv = (M/dt^2 + C/2dt)^-1, K2 = 2M/dt^2 - K, Cm1 = M/dt^2 - C/2dt.
  * work: 2 n*n doubles, piv: n ints. Returns 0 or -1 (singular). */
 RR_API int rr_cd_build(int n, const double *M, const double *D, const double *K0, const double *G1,
-                       const double *C1, const double *N2, const double *S2, const double *E1, double omega,
-                       double omega_dot, double dt, double *Ainv, double *K2, double *Cm1, double *work, int *piv);
+                       const double *C1, const double *N2, const double *S2, const double *E1, const double *S4,
+                       double omega, double omega_dot, double dt, double *Ainv, double *K2, double *Cm1, double *work,
+                       int *piv);
+
+/* The step's matrices by blocks (rr_cd_blocks) from the dense model matrices (read at the arrow's blocks only),
+ * in rr_cd_build's arithmetic: store holds rr_cd_blocks_size(ns, nb, m, nc) doubles the struct's pointers are set
+ * into; work rr_cd_blocks_work_size(ns, m, nc) doubles, piv max(ns, m, nc) ints. Returns 0, or -1 (a layout that
+ * does not add up, or a singular block). */
+RR_API int rr_cd_blocks_size(int ns, int nb, int m, int nc);
+RR_API int rr_cd_blocks_work_size(int ns, int m, int nc);
+RR_API int rr_cd_build_blocks(int n, int ns, int nb, int m, int nc, const double *M, const double *D, const double *K0,
+                              const double *G1, const double *C1, const double *N2, const double *S2,
+                              const double *E1, const double *S4, double omega, double omega_dot, double dt,
+                              double *store, rr_cd_blocks *b, double *work, int *piv);
 
 #ifdef __cplusplus
 }

@@ -3,42 +3,128 @@
 
 /* ------------------------------------------------------------------ central differences */
 
+/* y += K2 x - Cm1 xp for one block of rows (r x c): the order of the dense step's sums */
+static void block_mv(int r, int cc, const double *restrict K2, const double *restrict Cm1, const double *restrict x,
+                     const double *restrict xp, double *restrict y)
+{
+    int k, e;
+    for (k = 0; k < r; ++k) {
+        const double *K2k = K2 + (size_t)k * cc, *Cm1k = Cm1 + (size_t)k * cc;
+        double acc = y[k];
+        for (e = 0; e < cc; ++e) acc += K2k[e] * x[e] - Cm1k[e] * xp[e];
+        y[k] = acc;
+    }
+}
+
+/* y = A x (r x c) */
+static void mv(int r, int cc, const double *restrict A, const double *restrict x, double *restrict y)
+{
+    int k, e;
+    for (k = 0; k < r; ++k) {
+        const double *Ak = A + (size_t)k * cc;
+        double acc = 0.0;
+        for (e = 0; e < cc; ++e) acc += Ak[e] * x[e];
+        y[k] = acc;
+    }
+}
+
+/* The step's linear part by blocks (rr_cd_blocks): every product touches a hub block, one blade's blocks or the
+ * casing's, so its cost grows linearly with the blades; the solve is the Schur complement on the hub. rhs holds
+ * the loads on entry; q, qp the scheme's two states (qp <- q, q <- the new state); work: m + ns doubles. */
+static void block_step(const rr_cd_blocks *b, double *restrict q, double *restrict qp, double *restrict rhs,
+                       double *restrict work)
+{
+    int j, k, ns = b->ns, nb = b->nb, m = b->m, nc = b->nc, n = ns + nb * m + nc;
+    size_t hb = (size_t)ns * m, bb = (size_t)m * m;
+    const double *qh = q, *qph = qp;
+    double *z = work, *t = work + m;
+    /* rhs += K2 q - Cm1 qp */
+    block_mv(ns, ns, b->K2_hh, b->C_hh, qh, qph, rhs);
+    for (j = 0; j < nb; ++j) {
+        const double *qj = q + ns + (size_t)j * m, *qpj = qp + ns + (size_t)j * m;
+        double *rj = rhs + ns + (size_t)j * m;
+        block_mv(ns, m, b->K2_hb + j * hb, b->C_hb + j * hb, qj, qpj, rhs);
+        block_mv(m, ns, b->K2_bh + j * hb, b->C_bh + j * hb, qh, qph, rj);
+        block_mv(m, m, b->K2_bb + j * bb, b->C_bb + j * bb, qj, qpj, rj);
+    }
+    if (nc) block_mv(nc, nc, b->K2_cc, b->C_cc, q + ns + nb * m, qp + ns + nb * m, rhs + ns + nb * m);
+    for (k = 0; k < n; ++k) qp[k] = q[k];
+    /* A q = rhs: z_j = A_bb_j^-1 r_j; the hub from its Schur complement; the blades from z_j - W_j q_h */
+    for (k = 0; k < ns; ++k) t[k] = rhs[k];
+    for (j = 0; j < nb; ++j) {
+        const double *Ahb = b->A_hb + j * hb;
+        mv(m, m, b->Binv + j * bb, rhs + ns + (size_t)j * m, z);
+        for (k = 0; k < ns; ++k) {
+            const double *row = Ahb + (size_t)k * m;
+            double acc = 0.0;
+            int e;
+            for (e = 0; e < m; ++e) acc += row[e] * z[e];
+            t[k] -= acc;
+        }
+        for (k = 0; k < m; ++k) q[ns + (size_t)j * m + k] = z[k]; /* z_j, completed once the hub is known */
+    }
+    mv(ns, ns, b->Sinv, t, q);
+    for (j = 0; j < nb; ++j) {
+        const double *Wj = b->W + j * (size_t)m * ns;
+        double *qj = q + ns + (size_t)j * m;
+        for (k = 0; k < m; ++k) {
+            const double *row = Wj + (size_t)k * ns;
+            double acc = 0.0;
+            int e;
+            for (e = 0; e < ns; ++e) acc += row[e] * q[e];
+            qj[k] -= acc;
+        }
+    }
+    if (nc) mv(nc, nc, b->Cinv, rhs + ns + nb * m, q + ns + nb * m);
+}
+
 /* One step: (M/dt^2 + C/2dt) q+ = r F + F0 + F_nl(q, q') + (2M/dt^2 - K) q - (M/dt^2 - C/2dt) q-,
  * with the contact force at the current state only (explicit; q' = (q - q-)/dt for the friction),
  * from the laws and friction factors already evaluated there. The order of the sums is fixed (see
  * the header); locals and restrict let the compiler keep the matrices streaming instead of
- * reloading the structs after every store. */
-void rri_cd_update(int n, int nb, int np, double l, const double *restrict law, const double *restrict fr,
-                      const double *restrict A, const double *restrict B, const double *restrict S,
-                      const double *restrict Ainv, const double *restrict K2, const double *restrict Cm1,
-                      const double *restrict f, const double *restrict f0, double r, double *restrict q,
-                      double *restrict qp, double *restrict rhs)
+ * reloading the structs after every store. rhs: n doubles (+ m + ns for a block step). */
+void rri_cd_update(const rr_contact *c, const double *restrict law, const double *restrict fr,
+                   const rr_cd_matrices *mats, double r, double *restrict q, double *restrict qp,
+                   double *restrict rhs)
 {
-    int j, k, e;
+    int j, k, e, n = c->n, nb = c->nb, np = c->np, ld = rri_ld(c);
+    const double *restrict f = mats->f, *restrict f0 = mats->f0;
+    const double *restrict A = c->A, *restrict B = c->B, *restrict S = c->S;
     for (k = 0; k < n; ++k) rhs[k] = f0 ? r * f[k] + f0[k] : r * f[k];
     for (j = 0; j < nb; ++j) {
         const double *L = law + RR_LAW_WIDTH * j;
-        const double *Aj = A + (size_t)j * n, *Bj = B + (size_t)j * n;
-        const double *S0 = S + (size_t)j * np * n, *S1 = S0 + (np == 2 ? n : 0);
+        const double *Aj = A + (size_t)j * ld, *Bj = B + (size_t)j * ld;
+        const double *S0 = S + (size_t)j * np * ld, *S1 = S0 + (np == 2 ? ld : 0);
+        const int *cols = rri_cols(c, j);
         double FN = L[0], MN = L[1], w[2], aF[2], aM[2], c0, c1;
         if (FN == 0.0 && MN == 0.0) continue; /* adds an exact zero */
-        rri_point_weights(np, l, FN, MN, w, aF, aM);
+        rri_point_weights(np, rri_len(c, j), FN, MN, w, aF, aM);
         c0 = fr[(size_t)j * np] * w[0];
         c1 = np == 2 ? fr[(size_t)j * np + 1] * w[1] : 0.0;
-        for (k = 0; k < n; ++k) rhs[k] += Aj[k] * FN + Bj[k] * MN - (c0 * S0[k] + c1 * S1[k]);
+        if (cols)
+            for (k = 0; k < ld; ++k) rhs[cols[k]] += Aj[k] * FN + Bj[k] * MN - (c0 * S0[k] + c1 * S1[k]);
+        else
+            for (k = 0; k < n; ++k) rhs[k] += Aj[k] * FN + Bj[k] * MN - (c0 * S0[k] + c1 * S1[k]);
     }
-    for (k = 0; k < n; ++k) {
-        const double *K2k = K2 + (size_t)k * n, *Cm1k = Cm1 + (size_t)k * n;
-        double acc = rhs[k];
-        for (e = 0; e < n; ++e) acc += K2k[e] * q[e] - Cm1k[e] * qp[e];
-        rhs[k] = acc;
+    if (mats->blocks) {
+        block_step(mats->blocks, q, qp, rhs, rhs + n);
+        return;
     }
-    for (k = 0; k < n; ++k) qp[k] = q[k];
-    for (k = 0; k < n; ++k) {
-        const double *Ak = Ainv + (size_t)k * n;
-        double acc = 0.0;
-        for (e = 0; e < n; ++e) acc += Ak[e] * rhs[e];
-        q[k] = acc;
+    {
+        const double *restrict K2 = mats->K2, *restrict Cm1 = mats->Cm1, *restrict Ainv = mats->Ainv;
+        for (k = 0; k < n; ++k) {
+            const double *K2k = K2 + (size_t)k * n, *Cm1k = Cm1 + (size_t)k * n;
+            double acc = rhs[k];
+            for (e = 0; e < n; ++e) acc += K2k[e] * q[e] - Cm1k[e] * qp[e];
+            rhs[k] = acc;
+        }
+        for (k = 0; k < n; ++k) qp[k] = q[k];
+        for (k = 0; k < n; ++k) {
+            const double *Ak = Ainv + (size_t)k * n;
+            double acc = 0.0;
+            for (e = 0; e < n; ++e) acc += Ak[e] * rhs[e];
+            q[k] = acc;
+        }
     }
 }
 
@@ -169,8 +255,7 @@ int rr_cd_run(rr_cd_job *job)
             s->diverged = 1;
             break;
         }
-        rri_cd_update(n, nb, c->np, c->chord, law, fr, c->A, c->B, c->S, m->Ainv, m->K2, m->Cm1, m->f, m->f0, r * me,
-                  q, qp, rhs);
+        rri_cd_update(c, law, fr, m, r * me, q, qp, rhs);
         ++done;
         if (sf) {
             double phi_new = s->phi + (i + 1) * dt * omega; /* as s->phi at the end of the job */
@@ -186,18 +271,20 @@ int rr_cd_run(rr_cd_job *job)
         rri_laws_of(c, gaps, law);
         rri_friction_of(c, law, omega, NULL, q, qp, dt, fr);
         if (rec_wear && (step0 + i + 1) % rec_wear_every == 0 && job->n_rec_wear < job->rec_wear_cap) {
-            int m, p, ns = sf->n_sectors, np = c->np;
+            int m, p, ns = sf->n_sectors, nr = rri_n_rows(c);
             double *dst = rec_wear + (size_t)job->n_rec_wear * ns;
             for (m = 0; m < ns; ++m) {
                 double w = 0.0;
-                for (p = 0; p < np; ++p) w += sf->depth[(size_t)p * ns + m];
-                dst[m] = w / np;
+                for (p = 0; p < nr; ++p) w += sf->depth[(size_t)p * ns + m];
+                dst[m] = w / nr;
             }
             ++job->n_rec_wear;
         }
         if ((step0 + i + 1) % rec_every == 0 && written < rec_cap) {
             for (k = 0; k < n; ++k) rec_q[(size_t)written * n + k] = q[k];
-            if (rec_out) rri_outputs_from_law(c, q, gaps, law, fr, 0.0, NULL, rec_out + (size_t)written * RR_N_OUT(nb));
+            if (rec_out)
+                rri_outputs_from_law(c, q, gaps, law, fr, 0.0, NULL,
+                                     rec_out + (size_t)written * RR_N_OUT(rri_nb_out(c)));
             ++written;
         }
         if (stop_on_contact) {
@@ -224,12 +311,14 @@ int rr_cd_run(rr_cd_job *job)
 
 /* ------------------------------------------------------------------ the scheme's matrices and step limit */
 
-void rr_k_omega(int n, const double *K0, const double *S2, const double *N2, const double *C1, double omega,
-                double *out)
+void rr_k_omega(int n, const double *K0, const double *S2, const double *N2, const double *C1, const double *S4,
+                double omega, double *out)
 {
     size_t i, nn = (size_t)n * n;
-    double ww = omega * omega;
+    double ww = omega * omega, w4 = ww * ww;
     for (i = 0; i < nn; ++i) out[i] = K0[i] + ww * (S2[i] + N2[i]) + omega * C1[i];
+    if (S4) /* an imported blade's prestress beyond the quadratic (FE stiffness at several speeds) */
+        for (i = 0; i < nn; ++i) out[i] += w4 * S4[i];
 }
 
 int rr_critical_step_work_size(int n) { return 2 * n * n + 3 * n; }
@@ -256,8 +345,8 @@ double rr_critical_step(const rr_contact *c, double omega, const double *Minv, c
 }
 
 int rr_cd_build(int n, const double *M, const double *D, const double *K0, const double *G1, const double *C1,
-                   const double *N2, const double *S2, const double *E1, double omega, double omega_dot, double dt,
-                   double *Ainv, double *K2, double *Cm1, double *work, int *piv)
+                const double *N2, const double *S2, const double *E1, const double *S4, double omega,
+                double omega_dot, double dt, double *Ainv, double *K2, double *Cm1, double *work, int *piv)
 {
     size_t i, nn = (size_t)n * n;
     double dt2 = dt * dt, ww = omega * omega, two_dt = 2.0 * dt;
@@ -266,9 +355,129 @@ int rr_cd_build(int n, const double *M, const double *D, const double *K0, const
         double C = D[i] + omega * G1[i];
         double K = K0[i] + ww * (S2[i] + N2[i]) + omega * C1[i];
         if (E1) K = K + omega_dot * E1[i];
+        if (S4) K = K + omega * omega * (omega * omega) * S4[i];
         Aeff[i] = M[i] / dt2 + C / two_dt;
         K2[i] = 2.0 * M[i] / dt2 - K;
         Cm1[i] = M[i] / dt2 - C / two_dt;
     }
     return rr_inverse(n, Aeff, Ainv, work, piv);
+}
+
+/* ------------------------------------------------------------------ the step's matrices by blocks */
+
+int rr_cd_blocks_size(int ns, int nb, int m, int nc)
+{
+    size_t hb = (size_t)ns * m, bb = (size_t)m * m;
+    /* K2 and Cm1 blocks, A_hb, Binv, W, Sinv, Cinv */
+    return (int)(2 * ((size_t)ns * ns + 2 * nb * hb + nb * bb + (size_t)nc * nc) + nb * hb + nb * bb + nb * hb +
+                 (size_t)ns * ns + (size_t)nc * nc);
+}
+
+int rr_cd_blocks_work_size(int ns, int m, int nc)
+{
+    int big = ns > m ? ns : m;
+    if (nc > big) big = nc;
+    return 3 * big * big + ns * m;
+}
+
+/* one entry of the three step matrices at (i, j) of the dense model matrices, in rr_cd_build's arithmetic */
+static void step_entry(size_t i, const double *M, const double *D, const double *K0, const double *G1, const double *C1,
+                       const double *N2, const double *S2, const double *E1, const double *S4, double omega,
+                       double omega_dot, double dt2, double two_dt, double *a, double *k2, double *cm1)
+{
+    double C = D[i] + omega * G1[i];
+    double K = K0[i] + omega * omega * (S2[i] + N2[i]) + omega * C1[i];
+    if (E1) K = K + omega_dot * E1[i];
+    if (S4) K = K + omega * omega * (omega * omega) * S4[i];
+    *a = M[i] / dt2 + C / two_dt;
+    *k2 = 2.0 * M[i] / dt2 - K;
+    *cm1 = M[i] / dt2 - C / two_dt;
+}
+
+int rr_cd_build_blocks(int n, int ns, int nb, int m, int nc, const double *M, const double *D, const double *K0,
+                       const double *G1, const double *C1, const double *N2, const double *S2, const double *E1,
+                       const double *S4, double omega, double omega_dot, double dt, double *store, rr_cd_blocks *b,
+                       double *work, int *piv)
+{
+    size_t hb = (size_t)ns * m, bb = (size_t)m * m, off = 0;
+    double dt2 = dt * dt, two_dt = 2.0 * dt;
+    double *Ahh, *Abb, *Abh, *tmp;
+    int i, j, k, e, big = ns > m ? ns : m;
+    if (nc > big) big = nc;
+    if (ns + nb * m + nc != n || ns < 1 || nb < 1 || m < 1 || nc < 0) return -1;
+    b->ns = ns;
+    b->nb = nb;
+    b->m = m;
+    b->nc = nc;
+#define RR_TAKE(field, count) (b->field = store + off, off += (count))
+    RR_TAKE(K2_hh, (size_t)ns * ns);
+    RR_TAKE(K2_hb, nb * hb);
+    RR_TAKE(K2_bh, nb * hb);
+    RR_TAKE(K2_bb, nb * bb);
+    RR_TAKE(K2_cc, (size_t)nc * nc);
+    RR_TAKE(C_hh, (size_t)ns * ns);
+    RR_TAKE(C_hb, nb * hb);
+    RR_TAKE(C_bh, nb * hb);
+    RR_TAKE(C_bb, nb * bb);
+    RR_TAKE(C_cc, (size_t)nc * nc);
+    RR_TAKE(A_hb, nb * hb);
+    RR_TAKE(Binv, nb * bb);
+    RR_TAKE(W, nb * hb);
+    RR_TAKE(Sinv, (size_t)ns * ns);
+    RR_TAKE(Cinv, (size_t)nc * nc);
+#undef RR_TAKE
+    /* work: A_hh (big^2), a blade's A_bb, A_bh (big^2 each) and the inverse's scratch (big^2) */
+    Ahh = work;
+    Abb = Ahh + (size_t)big * big;
+    Abh = Abb + (size_t)big * big;
+    tmp = Abh + (size_t)ns * m;
+    for (i = 0; i < ns; ++i)
+        for (k = 0; k < ns; ++k) {
+            size_t at = (size_t)i * n + k;
+            step_entry(at, M, D, K0, G1, C1, N2, S2, E1, S4, omega, omega_dot, dt2, two_dt, Ahh + (size_t)i * ns + k,
+                       (double *)b->K2_hh + (size_t)i * ns + k, (double *)b->C_hh + (size_t)i * ns + k);
+        }
+    for (j = 0; j < nb; ++j) {
+        int j0 = ns + j * m;
+        double *k2hb = (double *)b->K2_hb + j * hb, *chb = (double *)b->C_hb + j * hb, *ahb = (double *)b->A_hb + j * hb;
+        double *k2bh = (double *)b->K2_bh + j * hb, *cbh = (double *)b->C_bh + j * hb;
+        double *k2bb = (double *)b->K2_bb + j * bb, *cbb = (double *)b->C_bb + j * bb;
+        double *Bj = (double *)b->Binv + j * bb, *Wj = (double *)b->W + j * hb;
+        for (i = 0; i < ns; ++i)
+            for (k = 0; k < m; ++k) {
+                step_entry((size_t)i * n + j0 + k, M, D, K0, G1, C1, N2, S2, E1, S4, omega, omega_dot, dt2, two_dt,
+                           ahb + (size_t)i * m + k, k2hb + (size_t)i * m + k, chb + (size_t)i * m + k);
+                step_entry((size_t)(j0 + k) * n + i, M, D, K0, G1, C1, N2, S2, E1, S4, omega, omega_dot, dt2, two_dt,
+                           Abh + (size_t)k * ns + i, k2bh + (size_t)k * ns + i, cbh + (size_t)k * ns + i);
+            }
+        for (i = 0; i < m; ++i)
+            for (k = 0; k < m; ++k)
+                step_entry((size_t)(j0 + i) * n + j0 + k, M, D, K0, G1, C1, N2, S2, E1, S4, omega, omega_dot, dt2,
+                           two_dt, Abb + (size_t)i * m + k, k2bb + (size_t)i * m + k, cbb + (size_t)i * m + k);
+        if (rr_inverse(m, Abb, Bj, tmp, piv) != 0) return -1;
+        /* W_j = A_bb^-1 A_bh (m x ns); A_hh -= A_hb W_j */
+        for (i = 0; i < m; ++i)
+            for (k = 0; k < ns; ++k) {
+                double s = 0.0;
+                for (e = 0; e < m; ++e) s += Bj[(size_t)i * m + e] * Abh[(size_t)e * ns + k];
+                Wj[(size_t)i * ns + k] = s;
+            }
+        for (i = 0; i < ns; ++i)
+            for (k = 0; k < ns; ++k) {
+                double s = 0.0;
+                for (e = 0; e < m; ++e) s += ahb[(size_t)i * m + e] * Wj[(size_t)e * ns + k];
+                Ahh[(size_t)i * ns + k] -= s;
+            }
+    }
+    if (rr_inverse(ns, Ahh, (double *)b->Sinv, tmp, piv) != 0) return -1;
+    if (nc > 0) {
+        int c0 = ns + nb * m;
+        for (i = 0; i < nc; ++i)
+            for (k = 0; k < nc; ++k)
+                step_entry((size_t)(c0 + i) * n + c0 + k, M, D, K0, G1, C1, N2, S2, E1, S4, omega, omega_dot, dt2,
+                           two_dt, Abb + (size_t)i * nc + k, (double *)b->K2_cc + (size_t)i * nc + k,
+                           (double *)b->C_cc + (size_t)i * nc + k);
+        if (rr_inverse(nc, Abb, (double *)b->Cinv, tmp, piv) != 0) return -1;
+    }
+    return 0;
 }

@@ -1,19 +1,25 @@
-/* rotorub kernel: gaps, friction, generalised contact force and its Jacobians, outputs of a state (see rotorub_kernel.h; internal declarations in rr_internal.h). */
+/* rotorub kernel: gaps, friction, the generalised contact force and its Jacobians, outputs of a state (see
+ * rotorub_kernel.h; internal declarations in rr_internal.h).
+ *
+ * A 'blade' here is what the law is evaluated on: a built-in blade (one chord, dense rows over every dof) or a
+ * segment of an imported blade's tip (its own length and share of k_r, rows over the dofs it touches only: the
+ * shaft, its blade, the casing). The arithmetic of the built-in case is the one it always had (bit for bit). */
 #include "rr_internal.h"
 
 /* gaps to the unworn, centred casing */
 void rri_raw_gaps(const rr_contact *c, const double *q, double *gaps)
 {
-    int row, k, n = c->n, rows = c->nb * c->np;
-    for (row = 0; row < rows; ++row) {
-        const double *g = c->G + (size_t)row * n;
-        double s = 0.0;
-        for (k = 0; k < n; ++k) s += g[k] * q[k];
-        gaps[row] = c->g0 + s; /* g0 added last: gap - g0 does not depend on g0 (exact detection maps) */
+    int j, p, np = c->np, ld = rri_ld(c);
+    for (j = 0; j < c->nb; ++j) {
+        const int *cols = rri_cols(c, j);
+        for (p = 0; p < np; ++p) {
+            size_t row = (size_t)j * np + p;
+            double s = rri_dot(ld, c->G + row * ld, cols, q);
+            if (c->g_off) s = c->g_off[row] + s;
+            gaps[row] = c->g0 + s; /* g0 added last: gap - g0 does not depend on g0 (exact detection maps) */
+        }
     }
 }
-
-void rri_surface_apply(const rr_contact *c, double *gaps);
 
 void rri_gaps_of(const rr_contact *c, const double *q, double *gaps)
 {
@@ -26,7 +32,7 @@ void rri_laws_of(const rr_contact *c, const double *gaps, double *law)
     int j;
     for (j = 0; j < c->nb; ++j) {
         const double *g = gaps + (size_t)c->np * j;
-        rri_blade_law(&c->law, c->np, g[0], g[c->np - 1], c->k_r, c->chord, law + RR_LAW_WIDTH * j);
+        rri_blade_law(&c->law, c->np, g[0], g[c->np - 1], rri_k(c, j), rri_len(c, j), law + RR_LAW_WIDTH * j);
     }
 }
 
@@ -44,7 +50,7 @@ void rr_potential_batch(const rr_contact *c, int m, const double *gaps, double *
         const double *g = gaps + (size_t)i * rows;
         double v = 0.0;
         for (j = 0; j < c->nb; ++j) {
-            rri_blade_law(&c->law, np, g[np * j], g[np * j + np - 1], c->k_r, c->chord, L);
+            rri_blade_law(&c->law, np, g[np * j], g[np * j + np - 1], rri_k(c, j), rri_len(c, j), L);
             v += L[7];
         }
         out[i] = v;
@@ -56,6 +62,7 @@ rr_contact rri_closed_contact(const rr_contact *c)
     rr_contact closed = *c;
     int i;
     closed.g0 = -1.0;
+    closed.g_off = NULL;   /* closed everywhere, whatever each point's rest gap */
     closed.surface = NULL; /* every blade closed: the surface changes nothing the stiffness sees */
     closed.k_r = c->k_r * rri_law_max_slope(&c->law);
     closed.law.id = RR_LAW_PENALTY;
@@ -82,15 +89,15 @@ void rr_gaps_batch(const rr_contact *c, int m, const double *Q, double *gaps)
 
 /* ------------------------------------------------------------------ friction */
 
-
 /* Friction factors mu tanh(v_p / v_slip) of every point of a blade in contact, from the law at q;
  * the velocity is qdot, or (q - q_prev) / dt when qdot is NULL and q_prev is not, or zero. */
 void rri_friction_of(const rr_contact *c, const double *law, double omega, const double *qdot, const double *q,
-                        const double *q_prev, double dt, double *fr)
+                     const double *q_prev, double dt, double *fr)
 {
-    int j, p, e, n = c->n, np = c->np;
+    int j, p, e, np = c->np, ld = rri_ld(c);
     for (j = 0; j < c->nb; ++j) {
         const double *L = law + RR_LAW_WIDTH * j;
+        const int *cols = rri_cols(c, j);
         int touching = !(L[0] == 0.0 && L[1] == 0.0);
         for (p = 0; p < np; ++p) {
             size_t pk = (size_t)j * np + p;
@@ -100,14 +107,16 @@ void rri_friction_of(const rr_contact *c, const double *law, double omega, const
                 continue;
             }
             v = omega * rri_spin_arm(c->points + 3 * pk, c->tangents + 3 * pk);
-            if (qdot || q_prev) {
-                const double *S = c->S + pk * n;
+            if (qdot) {
+                v += rri_dot(ld, c->S + pk * ld, cols, qdot);
+            } else if (q_prev) {
+                const double *S = c->S + pk * ld;
                 double sv = 0.0;
-                if (qdot)
-                    for (e = 0; e < n; ++e) sv += S[e] * qdot[e];
+                if (cols)
+                    for (e = 0; e < ld; ++e) sv += S[e] * (q[cols[e]] - q_prev[cols[e]]);
                 else
-                    for (e = 0; e < n; ++e) sv += S[e] * (q[e] - q_prev[e]);
-                v += qdot ? sv : sv / dt;
+                    for (e = 0; e < ld; ++e) sv += S[e] * (q[e] - q_prev[e]);
+                v += sv / dt;
             }
             fr[pk] = c->mu * rr_tanh(v / c->v_slip);
         }
@@ -126,21 +135,23 @@ void rr_friction(const rr_contact *c, const double *q, const double *qdot, doubl
  * casing part of G and S). */
 static void force_from_law(const rr_contact *c, const double *law, const double *fr, double *f)
 {
-    int j, k, p, n = c->n, np = c->np;
+    int j, k, p, n = c->n, np = c->np, ld = rri_ld(c);
     for (k = 0; k < n; ++k) f[k] = 0.0;
     for (j = 0; j < c->nb; ++j) {
         const double *L = law + RR_LAW_WIDTH * j;
-        const double *A = c->A + (size_t)j * n, *B = c->B + (size_t)j * n;
+        const double *A = c->A + (size_t)j * ld, *B = c->B + (size_t)j * ld;
+        const int *cols = rri_cols(c, j);
         double w[2], aF[2], aM[2];
         if (L[0] == 0.0 && L[1] == 0.0) continue;
-        rri_point_weights(np, c->chord, L[0], L[1], w, aF, aM);
-        for (k = 0; k < n; ++k) f[k] += A[k] * L[0] + B[k] * L[1];
+        rri_point_weights(np, rri_len(c, j), L[0], L[1], w, aF, aM);
+        if (cols)
+            for (k = 0; k < ld; ++k) f[cols[k]] += A[k] * L[0] + B[k] * L[1];
+        else
+            for (k = 0; k < n; ++k) f[k] += A[k] * L[0] + B[k] * L[1];
         for (p = 0; p < np; ++p) {
             size_t pk = (size_t)j * np + p;
-            const double *S = c->S + pk * n;
             double fw = fr[pk] * w[p];
-            if (fw != 0.0)
-                for (k = 0; k < n; ++k) f[k] -= fw * S[k];
+            if (fw != 0.0) rri_axpy(ld, -fw, c->S + pk * ld, cols, f);
         }
     }
 }
@@ -156,7 +167,7 @@ void rr_force(const rr_contact *c, const double *q, const double *qdot, double o
 
 void rr_jacobian(const rr_contact *c, const double *q, const double *qdot, double omega, double *J, double *Jv)
 {
-    int j, r, k, p, e, n = c->n, nb = c->nb, np = c->np, rows = nb * np;
+    int j, r, k, p, e, n = c->n, nb = c->nb, np = c->np, rows = nb * np, ld = rri_ld(c);
     double *gaps = c->work, *law = gaps + rows, *fr = law + nb * RR_LAW_WIDTH;
     rr_laws(c, q, gaps, law);
     rri_friction_of(c, law, omega, qdot, NULL, NULL, 1.0, fr);
@@ -165,40 +176,42 @@ void rr_jacobian(const rr_contact *c, const double *q, const double *qdot, doubl
         for (r = 0; r < n * n; ++r) Jv[r] = 0.0;
     for (j = 0; j < nb; ++j) {
         const double *L = law + RR_LAW_WIDTH * j;
-        const double *A = c->A + (size_t)j * n, *B = c->B + (size_t)j * n;
-        const double *S0 = c->S + (size_t)j * np * n, *S1 = np == 2 ? S0 + n : S0;
+        const double *A = c->A + (size_t)j * ld, *B = c->B + (size_t)j * ld;
+        const double *S0 = c->S + (size_t)j * np * ld, *S1 = np == 2 ? S0 + ld : S0;
+        const int *cols = rri_cols(c, j);
         double w[2], aF[2], aM[2], f0, f1;
         if (L[2] == 0.0 && L[3] == 0.0 && L[4] == 0.0 && L[5] == 0.0) continue;
-        rri_point_weights(np, c->chord, L[0], L[1], w, aF, aM);
+        rri_point_weights(np, rri_len(c, j), L[0], L[1], w, aF, aM);
         f0 = fr[(size_t)j * np];
         f1 = np == 2 ? fr[(size_t)j * np + 1] : 0.0;
-        for (r = 0; r < n; ++r) {
+        for (r = 0; r < ld; ++r) {
             /* row r of A^T dF + B^T dM - sum_p f_p S_p^T dw_p, dw_p = aF_p dF + aM_p dM,
              * dF = L2 A + L3 B, dM = L4 A + L5 B */
             double wF = A[r] - (f0 * aF[0] * S0[r] + (np == 2 ? f1 * aF[1] * S1[r] : 0.0));
             double wM = B[r] - (f0 * aM[0] * S0[r] + (np == 2 ? f1 * aM[1] * S1[r] : 0.0));
-            double *Jr = J + (size_t)r * n;
+            double *Jr = J + (size_t)(cols ? cols[r] : r) * n;
             if (wF == 0.0 && wM == 0.0) continue;
-            for (k = 0; k < n; ++k) {
+            for (k = 0; k < ld; ++k) {
                 double dF = L[2] * A[k] + L[3] * B[k];
                 double dM = L[4] * A[k] + L[5] * B[k];
-                Jr[k] += wF * dF + wM * dM;
+                Jr[cols ? cols[k] : k] += wF * dF + wM * dM;
             }
         }
         if (!Jv) continue;
         /* d/dq' of -mu tanh(v_p / v_slip) w_p S_p^T, v_p = omega rho_p + S_p q' */
         for (p = 0; p < np; ++p) {
             size_t pk = (size_t)j * np + p;
-            const double *S = c->S + pk * n;
+            const double *S = c->S + pk * ld;
             double th, cpl;
             if (c->mu == 0.0 || w[p] == 0.0) continue;
             th = fr[pk] / c->mu;
             cpl = c->mu * w[p] * (1.0 - th * th) / c->v_slip;
             if (cpl == 0.0) continue;
-            for (r = 0; r < n; ++r) {
+            for (r = 0; r < ld; ++r) {
                 double a = cpl * S[r];
+                double *Jr = Jv + (size_t)(cols ? cols[r] : r) * n;
                 if (a == 0.0) continue;
-                for (e = 0; e < n; ++e) Jv[(size_t)r * n + e] -= a * S[e];
+                for (e = 0; e < ld; ++e) Jr[cols ? cols[e] : e] -= a * S[e];
             }
         }
     }
@@ -207,20 +220,24 @@ void rr_jacobian(const rr_contact *c, const double *q, const double *qdot, doubl
 /* ------------------------------------------------------------------ outputs of a state */
 
 void rri_outputs_from_law(const rr_contact *c, const double *q, const double *gaps, const double *law,
-                             const double *fr, double phi, const int *index, double *dest)
+                          const double *fr, double phi, const int *index, double *dest)
 {
-    int j, k, p, nb = c->nb, np = c->np, n = c->n;
+    int j, k, p, nb = c->nb, np = c->np, n = c->n, nbo = rri_nb_out(c);
     double Fc[3] = {0.0, 0.0, 0.0}, torque = 0.0;
     double dx = 0.0, dy = 0.0, gmin = HUGE_VAL, cs, sn, vals[RR_OUT_GLOBALS];
-    int n_contact = 0;
+    /* what a reported blade gathers from its segments (a built-in blade: its one 'segment') */
+    double FN = 0.0, FT = 0.0, gle = 0.0, gte = 0.0, gtip = HUGE_VAL, frac = 0.0, len = 0.0;
+    int n_contact = 0, first = 1;
 #define RR_PUT(pos, value) (index ? (dest[index[(pos)]] = (value)) : (dest[(pos)] = (value)))
     for (j = 0; j < nb; ++j) {
         const double *L = law + RR_LAW_WIDTH * j;
-        double FN = L[0], MN = L[1], FT = 0.0, w[2], aF[2], aM[2];
-        double gle = gaps[np * j], gte = gaps[np * j + np - 1];
-        double gtip = (gle <= gte || gle != gle) ? gle : gte; /* a NaN propagates, as numpy's min */
-        if (!(FN == 0.0 && MN == 0.0)) {
-            rri_point_weights(np, c->chord, FN, MN, w, aF, aM);
+        int b = c->blade_of ? c->blade_of[j] : j, last = j + 1 == nb || (c->blade_of ? c->blade_of[j + 1] : j + 1) != b;
+        double w[2], aF[2], aM[2], lj = rri_len(c, j);
+        double sle = gaps[np * j], ste = gaps[np * j + np - 1];
+        double sg = (sle <= ste || sle != sle) ? sle : ste; /* a NaN propagates, as numpy's min */
+        double ft = 0.0;
+        if (!(L[0] == 0.0 && L[1] == 0.0)) {
+            rri_point_weights(np, lj, L[0], L[1], w, aF, aM);
             for (p = 0; p < np; ++p) {
                 /* on the casing: w_p (n_p + f_p t_p); its torque on the rotor about e_z is the opposite */
                 size_t pk = (size_t)j * np + p;
@@ -231,15 +248,32 @@ void rri_outputs_from_law(const rr_contact *c, const double *q, const double *ga
                     Fc[k] += f[k];
                 }
                 torque -= P[0] * f[1] - P[1] * f[0];
-                FT += fr[pk] * w[p];
+                ft += fr[pk] * w[p];
             }
         }
-        RR_PUT(RR_OUT_FN * nb + j, FN);
-        RR_PUT(RR_OUT_FT * nb + j, FT);
-        RR_PUT(RR_OUT_GAP_LE * nb + j, gle);
-        RR_PUT(RR_OUT_GAP_TE * nb + j, gte);
-        RR_PUT(RR_OUT_GAP_TIP * nb + j, gtip);
-        RR_PUT(RR_OUT_FRACTION * nb + j, L[6]);
+        if (first) { /* a blade's first segment: its leading edge */
+            FN = L[0];
+            FT = ft;
+            gle = sle;
+            gtip = sg;
+            frac = L[6] * lj;
+            len = lj;
+        } else {
+            FN += L[0];
+            FT += ft;
+            if (sg < gtip || sg != sg) gtip = sg;
+            frac += L[6] * lj;
+            len += lj;
+        }
+        gte = ste;
+        first = last;
+        if (!last) continue;
+        RR_PUT(RR_OUT_FN * nbo + b, FN);
+        RR_PUT(RR_OUT_FT * nbo + b, FT);
+        RR_PUT(RR_OUT_GAP_LE * nbo + b, gle);
+        RR_PUT(RR_OUT_GAP_TE * nbo + b, gte);
+        RR_PUT(RR_OUT_GAP_TIP * nbo + b, gtip);
+        RR_PUT(RR_OUT_FRACTION * nbo + b, c->blade_of ? frac / len : L[6]);
         if (FN > 0.0) ++n_contact;
         if (gtip < gmin || gtip != gtip) gmin = gtip;
     }
@@ -257,7 +291,7 @@ void rri_outputs_from_law(const rr_contact *c, const double *q, const double *ga
     vals[RR_OUT_DISK_Y] = sn * dx + cs * dy;
     vals[RR_OUT_GAP_MIN] = gmin;
     vals[RR_OUT_N_CONTACT] = (double)n_contact;
-    for (k = 0; k < RR_OUT_GLOBALS; ++k) RR_PUT(RR_OUT_BLADE_BLOCKS * nb + k, vals[k]);
+    for (k = 0; k < RR_OUT_GLOBALS; ++k) RR_PUT(RR_OUT_BLADE_BLOCKS * nbo + k, vals[k]);
 #undef RR_PUT
 }
 
@@ -276,5 +310,5 @@ void rr_outputs_batch(const rr_contact *c, int m, const double *Q, const double 
     int i;
     for (i = 0; i < m; ++i)
         rr_outputs(c, Q + (size_t)i * c->n, Qdot ? Qdot + (size_t)i * c->n : NULL, omega, 0.0, NULL,
-                   out + (size_t)i * RR_N_OUT(c->nb));
+                   out + (size_t)i * RR_N_OUT(rri_nb_out(c)));
 }

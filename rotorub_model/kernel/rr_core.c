@@ -9,8 +9,8 @@ int rr_abi_version(void) { return RR_ABI_VERSION; }
 
 const char *rr_source_id(void) { return RR_SOURCE_ID; }
 
-/* scratch: gaps (nb*np) + law (nb*7) + friction (nb*np) + right-hand side (n) */
-int rr_work_size(int n, int nb, int np) { return nb * np + nb * RR_LAW_WIDTH + nb * np + n; }
+/* scratch: gaps (nb*np) + law (nb*RR_LAW_WIDTH) + friction (nb*np) + right-hand side (n) + a block step's (n) */
+int rr_work_size(int n, int nb, int np) { return nb * np + nb * RR_LAW_WIDTH + nb * np + 2 * n; }
 
 void rr_elementary(int fn, int m, const double *x, const double *y, double *out)
 {

@@ -39,11 +39,9 @@ void rri_outputs_from_law(const rr_contact *c, const double *q, const double *ga
                           const double *fr, double phi, const int *index, double *dest);
 
 /* rr_cd.c: one central-difference step from the laws and friction factors already evaluated at q */
-void rri_cd_update(int n, int nb, int np, double l, const double *restrict law, const double *restrict fr,
-                   const double *restrict A, const double *restrict B, const double *restrict S,
-                   const double *restrict Ainv, const double *restrict K2, const double *restrict Cm1,
-                   const double *restrict f, const double *restrict f0, double r, double *restrict q,
-                   double *restrict qp, double *restrict rhs);
+void rri_cd_update(const rr_contact *c, const double *restrict law, const double *restrict fr,
+                   const rr_cd_matrices *mats, double r, double *restrict q, double *restrict qp,
+                   double *restrict rhs);
 
 /* rr_liner.c */
 void rri_surface_apply(const rr_contact *c, double *gaps);
@@ -56,6 +54,38 @@ int rri_surface_inputs_changed(const rr_surface *s);
 void rri_surface_recut(const rr_contact *c, const double *q, double *gaps);
 
 /* small and on the hot path: inline in every file */
+
+/* the rows of segment (blade) j: their stride, and the dofs of their columns (NULL: all n, dense) */
+static inline int rri_ld(const rr_contact *c) { return c->nloc > 0 ? c->nloc : c->n; }
+static inline const int *rri_cols(const rr_contact *c, int j)
+{
+    return c->nloc > 0 ? c->cols + (size_t)j * c->nloc : NULL;
+}
+static inline double rri_len(const rr_contact *c, int j) { return c->seg_len ? c->seg_len[j] : c->chord; }
+static inline double rri_k(const rr_contact *c, int j) { return c->seg_k ? c->seg_k[j] * c->k_r : c->k_r; }
+static inline int rri_nb_out(const rr_contact *c) { return c->nb_out > 0 ? c->nb_out : c->nb; }
+static inline int rri_row(const rr_contact *c, int k) { return c->point_row ? c->point_row[k] : k % c->np; }
+static inline int rri_n_rows(const rr_contact *c) { return c->point_row && c->n_rows > 0 ? c->n_rows : c->np; }
+/* row . x over the row's own columns (dense: the arithmetic of a plain dot product) */
+static inline double rri_dot(int len, const double *row, const int *cols, const double *x)
+{
+    double s = 0.0;
+    int k;
+    if (cols)
+        for (k = 0; k < len; ++k) s += row[k] * x[cols[k]];
+    else
+        for (k = 0; k < len; ++k) s += row[k] * x[k];
+    return s;
+}
+/* f += a row */
+static inline void rri_axpy(int len, double a, const double *row, const int *cols, double *f)
+{
+    int k;
+    if (cols)
+        for (k = 0; k < len; ++k) f[cols[k]] += a * row[k];
+    else
+        for (k = 0; k < len; ++k) f[k] += a * row[k];
+}
 /* Share of the blade's normal force carried by each contact point: the pressure p(c) >= 0 on
  * [-l/2, l/2] is statically equivalent to w_LE = F/2 - M/l at the LE and w_TE = F/2 + M/l at
  * the TE (both >= 0); dw/dF and dw/dM are (1/2, -1/l) and (1/2, 1/l). 2D: w = F_N. */

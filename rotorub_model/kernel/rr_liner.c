@@ -181,7 +181,8 @@ static void surface_shift(const rr_contact *c, double *gaps, int with_depth)
             lB[n] = s->lobe_amp[n] == 0.0 ? 0.0 : s->lobe_amp[n] * rr_sin(x);
         }
     for (k = 0; k < rows; ++k) {
-        double extra = (with_depth ? s->depth[(size_t)(k % np) * ns + cell_at(a0[k], turn, ns)] : 0.0) - s->closure;
+        double extra = (with_depth ? s->depth[(size_t)rri_row(c, k) * ns + cell_at(a0[k], turn, ns)] : 0.0) -
+                       s->closure;
         if (offset) {
             double ct = ca[k] * cp - sa[k] * sp, st = sa[k] * cp + ca[k] * sp;
             extra += nr[k] * (s->offset_x * ct + s->offset_y * st);
@@ -205,8 +206,7 @@ void rri_surface_cut(const rr_contact *c, const double *gaps, double phi_new)
     rr_surface *s = c->surface;
     int k, j, np = c->np, rows = c->nb * np, ns = s->n_sectors;
     const double *a0 = s->tables, *nr = a0 + 3 * rows, *bc = a0 + 4 * rows, *bs = bc + RR_WEAR_HARMONICS * ns;
-    const double share = np == 2 ? 0.5 : 1.0; /* 3D: each end carries half the chord */
-    const double kp = share * c->k_r, fy = share * s->yield_force, hp = share * s->hardening;
+    const double half = np == 2 ? 0.5 : 1.0; /* 3D: each end carries half the chord */
     const double reach = reach_of(s);
     const int offset = s->offset_x != 0.0 || s->offset_y != 0.0, lobes = has_lobes(s);
     double lC[RR_MAX_LOBES + 1], lS[RR_MAX_LOBES + 1];
@@ -220,9 +220,11 @@ void rri_surface_cut(const rr_contact *c, const double *gaps, double phi_new)
     const rr_turn turn0 = turn_of(s->phi, ns), turn1 = turn_of(phi_new, ns);
     const double turns = (phi_new - s->phi) * (ns / RR_TWO_PI);
     for (k = 0; k < rows; ++k) {
-        double g = gaps[k] - s->closure;
+        double g = gaps[k] - s->closure, share = c->point_share ? c->point_share[k] : half;
+        double kp = share * c->k_r, fy = share * s->yield_force, hp = share * s->hardening;
         int c0, c1, count, step;
-        double *row = s->depth + (size_t)(k % np) * ns;
+        double *row = s->depth + (size_t)rri_row(c, k) * ns;
+        if (share == 0.0) continue;                /* a station's second point: cut as its twin */
         if (g - nr[k] * reach >= 0.0) continue; /* open everywhere this point can be: nothing to cut */
         c0 = cell_at(a0[k], turn0, ns);
         c1 = cell_at(a0[k], turn1, ns);
@@ -259,13 +261,15 @@ void rri_surface_recut(const rr_contact *c, const double *q, double *gaps)
      * the time loop's sweep takes the inputs at the cells' centres, where it does not know the points' angles) */
     rr_surface *s = c->surface;
     int k, np = c->np, rows = c->nb * np, ns = s->n_sectors;
-    const double share = np == 2 ? 0.5 : 1.0; /* 3D: each end carries half the chord */
-    const double kp = share * c->k_r, fy = share * s->yield_force, hp = share * s->hardening;
+    const double half = np == 2 ? 0.5 : 1.0; /* 3D: each end carries half the chord */
     const rr_turn turn = turn_of(s->phi, ns);
     rri_raw_gaps(c, q, gaps);
     surface_shift(c, gaps, 0);
     for (k = 0; k < rows; ++k) {
-        double *w = s->depth + (size_t)(k % np) * ns + cell_at(s->tables[k], turn, ns);
+        double share = c->point_share ? c->point_share[k] : half;
+        double kp = share * c->k_r, fy = share * s->yield_force, hp = share * s->hardening;
+        double *w = s->depth + (size_t)rri_row(c, k) * ns + cell_at(s->tables[k], turn, ns);
+        if (share == 0.0) continue; /* a station's second point: cut as its twin */
         if (gaps[k] + *w < 0.0 && rri_point_force(&c->law, -(gaps[k] + *w), kp) > fy + hp * *w) {
             double work = 0.0;
             rri_liner_law(&c->law, gaps[k], kp, fy, hp, s->thickness, 1, w, &work);
@@ -278,7 +282,7 @@ void rri_surface_recut(const rr_contact *c, const double *q, double *gaps)
 
 void rr_surface_summary(const rr_contact *c, const rr_surface *s, double area_per_sector, double *out)
 {
-    int m, h, p, np = c->np, ns = s->n_sectors, rows = c->nb * np;
+    int m, h, p, np = rri_n_rows(c), ns = s->n_sectors, rows = c->nb * c->np;
     const double *bc = s->tables + 4 * rows, *bs = bc + RR_WEAR_HARMONICS * ns;
     double big = 0.0, sum = 0.0, best = 0.0, cs[RR_WEAR_HARMONICS], sn[RR_WEAR_HARMONICS];
     int lobes = 0;

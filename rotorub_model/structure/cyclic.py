@@ -51,7 +51,7 @@ def wave_transform(model) -> tuple[np.ndarray, np.ndarray]:
             T[i, i + 1], T[i + 1, i + 1] = 1 / np.sqrt(2), -1j / np.sqrt(2)
             conj[i], conj[i + 1] = i + 1, i
     sl = model.slices["blades"]
-    N, nb = model.params.blades.count, model.params.blades.dofs
+    N, nb = model.params.blades.count, model.blade_dofs
     a = 2.0 * np.pi * np.arange(N) / N
     F = np.exp(1j * np.outer(a, np.arange(N))) / np.sqrt(N)
     T[sl, sl] = np.kron(F, np.eye(nb))  # blade dofs are blade-major: q[sl].reshape(N, nb)

@@ -53,6 +53,14 @@ class Model:
     f_euler: np.ndarray  # inertia load of the blades at dOmega/dt = 1 rad/s^2
     slices: dict[str, slice]
     mistuning: tuple[float, ...] | None = None  # per-blade stiffness deviations (build_model); None: tuned
+    S4: np.ndarray | None = None  # Omega^4 term of an imported blade's prestressed stiffness (None: the built-in's)
+    fe_blade: object | None = None  # the imported blade (fe.blade.ReducedBlade) when [fe_blade] names one
+
+    @property
+    def blade_dofs(self) -> int:
+        """Generalised coordinates per blade (the built-in blade's functions, or an imported blade's modes)."""
+        sl = self.slices["blades"]
+        return (sl.stop - sl.start) // self.params.blades.count
 
     @property
     def n_dofs(self) -> int:
@@ -64,7 +72,7 @@ class Model:
     def K_omega(self, omega: float) -> np.ndarray:
         """K(Omega) = K + Ks(Omega^2) + N(Omega) + C(Omega): the kernel's (rr_k_omega), the same bits the FMUs and
         the time loop's matrices use."""
-        return kernel.k_omega(self.K, self.S2, self.N2, self.C1, float(omega))
+        return kernel.k_omega(self.K, self.S2, self.N2, self.C1, float(omega), self.S4)
 
     def force(self, omega: float, me: float | None = None, omega_dot: float = 0.0) -> np.ndarray:
         """Imbalance force F(Omega^2) (constant in the rotating frame); with an angular
@@ -86,6 +94,33 @@ class Model:
         from .cyclic import cyclic_blocks
 
         return cyclic_blocks(self)
+
+    @cached_property
+    def block_layout(self) -> tuple[int, int, int, int] | None:
+        """(hub dofs, blades, dofs per blade, casing dofs) when the matrices are arrows: the blades couple to the
+        shaft only, the casing to nothing (it meets the rotor through contact); what the time loop's block step
+        needs (a step then costs what grows linearly with the blades). None when any block breaks the pattern."""
+        sh, bl, cs = self.slices["shaft"], self.slices["blades"], self.slices["casing"]
+        nb = self.params.blades.count
+        nblade = bl.stop - bl.start
+        if nb < 1 or nblade % nb:
+            return None
+        m = nblade // nb
+        mats = [self.M, self.D, self.K, self.G1, self.C1, self.N2, self.S2, self.E1]
+        if self.S4 is not None:
+            mats.append(self.S4)
+        rotor = slice(sh.start, bl.stop)
+        for A in mats:
+            if np.any(A[rotor, cs]) or np.any(A[cs, rotor]):
+                return None
+            B = A[bl, bl]
+            for j in range(nb):
+                rows = slice(j * m, (j + 1) * m)
+                off = np.abs(B[rows]).copy()
+                off[:, rows] = 0.0
+                if np.any(off):
+                    return None
+        return sh.stop - sh.start, nb, m, cs.stop - cs.start
 
     @cached_property
     def M_inv(self) -> np.ndarray:
@@ -126,7 +161,22 @@ def build_model(params: Parameters | None = None, mistuning: Sequence[float] | n
     damping times 1 + delta_j, :func:`~rotorub_model.structure.blades.bladed_disk_matrices`); None: tuned."""
     p = params or reference_parameters()
     sh = shaft_matrices(p)
-    bd = bladed_disk_matrices(p, mistuning=mistuning)
+    blade = None
+    if p.fe_blade.superelement:  # an imported blade (docs/THEORY.md 9) in place of the built-in beams
+        from ..fe.blade import load_superelement
+        from ..fe.bladed_disk import fe_bladed_disk_matrices
+
+        blade = load_superelement(p.fe_blade.superelement)
+        bd = fe_bladed_disk_matrices(p, blade)
+        delta = check_mistuning(p, mistuning)
+        if delta is not None:  # blade j's stiffness and damping times 1 + delta_j, as the built-in blades'
+            ns0 = 2 * p.shaft.n_ritz
+            for j, dj in enumerate(delta):
+                sl = slice(ns0 + j * blade.m, ns0 + (j + 1) * blade.m)
+                bd.K[sl, sl] *= 1.0 + dj
+                bd.D[sl, sl] *= 1.0 + dj
+    else:
+        bd = bladed_disk_matrices(p, mistuning=mistuning)
     cs = casing_matrices(p)
     ns = len(sh.dofs)
     nbt = len(bd.dofs) - ns
@@ -150,6 +200,12 @@ def build_model(params: Parameters | None = None, mistuning: Sequence[float] | n
     model = Model(params=p, dofs=dofs, f_unit=np.zeros(n), f_tangential=np.zeros(n), f_euler=np.zeros(n),
                   slices=slices, mistuning=check_mistuning(p, mistuning), **mats)
     model.f_euler[slices["rotor"]] = bd.f_euler
+    if blade is not None:
+        model.fe_blade = blade
+        model.S4 = np.zeros((n, n))
+        model.S4[: ns + nbt, : ns + nbt] = bd.S4
+        if not np.any(model.S4):
+            model.S4 = None  # a prestress linear in Omega^2: K(Omega) as the built-in's
     T, _ = model.disk_maps
     ang = np.radians(p.imbalance.angle_deg)
     Ts, _ = station_maps(p, next(d for d in p.disks if d.name == p.imbalance.disk).z)

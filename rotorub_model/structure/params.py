@@ -207,6 +207,21 @@ class AbradableParams:
 
 
 @dataclass(frozen=True)
+class FEBladeParams:
+    """An imported finite-element blade in place of the built-in beam (docs/THEORY.md 9): a superelement file that
+    ``rotorub import-blade`` wrote (the reduced blade, its rotating-frame terms, its tip nodes). Off by default:
+    the built-in blades of [blades]. With it, [blades] gives the count, the tip radius (the casing's line) and the
+    stagger; the beam's own fields are not used."""
+
+    superelement: str = field(default="", metadata={"doc": "path of the superelement (.npz, relative to the "
+                                                           "parameter file); empty: the built-in blades",
+                                                    "path": True})
+    stations: int = _f(2, 64, integer=True, default=12,
+                       doc="the most chord stations the tip's nodes are gathered into (each station a point of "
+                           "the 3D contact law; the segments between them carry the chord law)")
+
+
+@dataclass(frozen=True)
 class NormalisationParams:
     omega_ref: float = _f(0, lo_open=True, doc="reference angular speed for the normalised spin speed [rad/s]")
     speed_max: float = _f(0, lo_open=True, default=12.0,
@@ -228,6 +243,7 @@ class Parameters:
     contact: ContactParams
     normalisation: NormalisationParams
     abradable: AbradableParams = AbradableParams()
+    fe_blade: FEBladeParams = FEBladeParams()
 
     def replace(self, **sections: dict[str, Any]) -> Parameters:
         """Return a copy with some fields of some sections replaced, validated again.
@@ -260,8 +276,9 @@ _SECTIONS: dict[str, type] = {
     "contact": ContactParams,
     "normalisation": NormalisationParams,
     "abradable": AbradableParams,
+    "fe_blade": FEBladeParams,
 }
-_OPTIONAL_SECTIONS = {"abradable"}  # may be left out of a parameter file: every field has its default
+_OPTIONAL_SECTIONS = {"abradable", "fe_blade"}  # may be left out of a parameter file: every field has its default
 _LISTS: dict[str, type] = {"bearings": BearingParams, "disks": DiskParams}
 
 
@@ -285,6 +302,10 @@ def _check_value(where: str, f: dataclasses.Field, value: Any) -> Any:
     if meta.get("bool"):
         if not isinstance(value, bool):
             raise ParameterError(f"{where}: expected true or false, got {value!r}")
+        return value
+    if meta.get("path"):
+        if not isinstance(value, str):
+            raise ParameterError(f"{where}: expected a file path (a string), got {value!r}")
         return value
     if f.type in ("str", str):
         choices = meta.get("choices")
@@ -424,14 +445,15 @@ def accepted_range(name: str) -> tuple[float, float]:
     parameter file, the FMUs' variables and the CLI); an open lower end is returned as the value itself (the
     callers that declare ranges, FMI among them, know only inclusive bounds: they refuse it separately)."""
     if name in INPUT_RANGES:
-        return INPUT_RANGES[name]
+        lo, hi = INPUT_RANGES[name]
+        return float(lo), float(hi)
     sec, _, fname = name.partition(".")
     cls = _SECTIONS.get(sec) or _LISTS.get(sec)
     f = next((f for f in fields(cls) if f.name == fname), None) if cls else None
     if f is None or "range" not in f.metadata:
         raise KeyError(f"{name}: no declared range")
     lo, hi, _ = f.metadata["range"]
-    return lo, hi
+    return float(lo), float(hi)
 
 
 def describe(name: str) -> str:
@@ -466,6 +488,11 @@ def load_parameters(path: str | Path | None = None) -> Parameters:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"parameter file '{where}': not valid TOML ({exc})") from None
+    # a superelement named relative to the parameter file: from its folder, wherever the command runs
+    fe = data.get("fe_blade") if isinstance(data, dict) else None
+    if path is not None and isinstance(fe, dict) and isinstance(fe.get("superelement"), str) and fe["superelement"]:
+        f = Path(fe["superelement"]).expanduser()
+        fe["superelement"] = str(f if f.is_absolute() else (Path(path).resolve().parent / f))
     try:
         return from_dict(data)
     except ParameterError as exc:

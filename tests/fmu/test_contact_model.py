@@ -409,3 +409,51 @@ def test_simulate_leaves_no_dangling_logger_in_fmpy(native_fmu, tmp_path):
     script.write_text(DANGLING_LOGGER)
     r = subprocess.run([sys.executable, str(script), str(native_fmu)], capture_output=True, text=True, timeout=300)
     assert r.returncode == 0 and "ended at" in r.stdout, (r.returncode, r.stderr[-2000:])
+
+
+# ------------------------------------------------------------------ the second normal law, the casing out of round
+def test_the_bilinear_law_through_the_fmu_equals_the_library(fmu, ref_model):
+    """law = bilinear as an FMU parameter (issue 24.5): the same run as the library with the same law, to round-off,
+    and different from the penalty law's (the stiffer layer beyond the knee carries the blades)."""
+    p = ref_model.params
+    omega, g0, me, t_end = 3.3 * p.normalisation.omega_ref, -0.4e-3, p.imbalance.me, 0.3
+    law = {"law": "bilinear", "knee": 0.2e-3, "stiffness_ratio": 3.0}
+    r = simulate(fmu, stop_time=t_end, output_interval=1e-3,
+                 start_values={"g0": g0, "formulation": "3D", "Omega": omega, "imbalance": me, **law}, output=FN)
+    from rotorub_model.structure.model import build_model
+
+    bil = build_model(p.replace(contact=law))
+    lib = run_transient(bil, make_contact(bil, "3D", g0=g0), omega, t_end=t_end, t_ramp=0.0, me=me, record_dt=1e-3,
+                        hold=1e-3)
+    pen = run_transient(ref_model, make_contact(ref_model, "3D", g0=g0), omega, t_end=t_end, t_ramp=0.0, me=me,
+                        record_dt=1e-3, hold=1e-3)
+    F = np.array([r[n] for n in FN]).T[1:]
+    scale = np.abs(lib.outputs["F_N"]).max()
+    assert np.abs(F - lib.outputs["F_N"]).max() <= 1e-9 * scale
+    assert np.abs(lib.outputs["F_N"] - pen.outputs["F_N"]).max() > 0.1 * scale
+
+
+def test_an_oval_casing_through_the_fmu_equals_the_library(fmu, ref_model):
+    """casing_lobe2.amplitude/phase as inputs (issue 27.1), set half-way through a run: the library's run with the same
+    distortion set between two runs (its final state carried over), to round-off; and the lobe shows in the forces
+    (blades opposite each other see the same gap: the force pattern has a 2-per-revolution part)."""
+    from rotorub_model.contact.liner import Liner
+
+    p = ref_model.params
+    omega, g0, me, t1, t_end = 3.3 * p.normalisation.omega_ref, 0.2e-3, p.imbalance.me, 0.2, 0.5
+    a, psi = 0.3e-3, 0.4
+    sig = np.array([(0.0, omega, me, 0.0), (t1 - 1e-9, omega, me, 0.0), (t1, omega, me, a), (t_end + 1, omega, me, a)],
+                   dtype=[("time", float), ("Omega", float), ("imbalance", float), ("casing_lobe2.amplitude", float)])
+    r = simulate(fmu, stop_time=t_end, output_interval=1e-3, input=sig,
+                 start_values={"g0": g0, "formulation": "3D", "casing_lobe2.phase": psi}, output=FN + ["gap_min"])
+    c = make_contact(ref_model, "3D", g0=g0)
+    casing = Liner(c, wears=False)
+    first = run_transient(ref_model, c, omega, t_end=t1, t_ramp=0.0, me=me, record_dt=1e-3, hold=1e-3, liner=casing)
+    casing.set_distortion({2: (a, psi)})
+    second = run_transient(ref_model, c, omega, t_end=t_end - t1, t_ramp=0.0, me=me, record_dt=1e-3, hold=1e-3,
+                           liner=casing, start=first.final_state)
+    lib = np.vstack([first.outputs["F_N"], second.outputs["F_N"]])
+    F = np.array([r[n] for n in FN]).T[1:]
+    assert F.shape == lib.shape and np.abs(lib).max() > 50.0
+    assert np.abs(F - lib).max() <= 1e-9 * np.abs(lib).max()
+    assert np.abs(second.outputs["F_N"][-100:] - lib[:100].mean(0)).max() > 1.0, "the lobe changes the rub"

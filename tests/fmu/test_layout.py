@@ -135,7 +135,7 @@ def test_the_fmi_layers_c_knows_no_model():
 
 def test_every_model_folder_has_the_same_file_names():
     folders = [d for d in (FMU / "models").iterdir() if d.is_dir() and d.name != "__pycache__"]
-    assert {d.name for d in folders} == {"contact", "spool", "clearance"}
+    assert {d.name for d in folders} == {"contact", "spool", "clearance", "casing_load"}
     for d in folders:
         assert MODEL_FILES <= {p.name for p in d.iterdir()}, d.name
         extra = {p.name for p in d.iterdir() if p.is_file()} - MODEL_FILES - {"slave.py"}  # where it has one

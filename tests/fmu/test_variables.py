@@ -71,7 +71,9 @@ def test_one_variable_list_gives_both_descriptions():
     d3 = xml_bytes(model_description(cv.MODEL, v, fmi="3.0", token="{x}", generation_tool="t", version="1"))
     two, _, _ = read_description(_zip(d2))
     three, _, root3 = read_description(_zip(d3))
-    assert len(two) == 107 and "param_file" not in two  # value references 0 to 107 but the pythonfmu flavour's 4
+    # value references 0 to 107 but the pythonfmu flavour's 4, then (after the FMI 3.0 FMU's own 108-110) the normal
+    # law's three parameters and the casing's lobes 2-4 (111-119)
+    assert len(two) == 116 and "param_file" not in two
     for name, w in three.items():
         if name in ("time", "n_blades", "penetration_margin"):
             continue
@@ -96,7 +98,8 @@ def _zip(xml: bytes) -> bytes:
 
 
 EXTRA = [  # FMU.md's example: a scalar parameter, a scalar input, a per-blade array output
-    Var("law", "Enumeration", "parameter", "fixed", "Normal contact law", start=1, min=1, max=2, declared_type="Law"),
+    Var("example_law", "Enumeration", "parameter", "fixed", "An example law", start=1, min=1, max=2,
+        declared_type="ExampleLaw"),
     Var("casing_distortion", "Real", "input", "continuous", "Ovalisation of the casing, held over each step",
         unit="m", display_unit="mm", start=0.0, min=-0.01, max=0.01, nominal=1e-4, feedthrough=False),
     Var("blade.F_wear", "Real", "output", "continuous", "Wear force on each blade (element j: blade j)", unit="N",
@@ -120,7 +123,8 @@ def test_adding_a_variable_is_one_entry_and_every_build_follows(tmp_path, monkey
         return numbered([*(original(d, mode)), *EXTRA])
 
     monkeypatch.setattr(cv, "variables", more)
-    monkeypatch.setattr(cv, "ENUMERATIONS", {**cv.ENUMERATIONS, "Law": (("penalty", "linear"), ("power", "F = k g^p"))})
+    monkeypatch.setattr(cv, "ENUMERATIONS", {**cv.ENUMERATIONS,
+                                             "ExampleLaw": (("penalty", "linear"), ("power", "F = k g^p"))})
     monkeypatch.setattr(cv, "MODEL", ModelInfo(**{**cv.MODEL.__dict__, "enumerations": cv.ENUMERATIONS}))
     for fmi in ("2.0", "3.0"):
         fmu = builder.build_native_fmu(tmp_path / fmi, platforms=("linux64",), fmi=fmi)["fmu"]
@@ -131,14 +135,15 @@ def test_adding_a_variable_is_one_entry_and_every_build_follows(tmp_path, monkey
         name = f"contact_native_fmi{fmi[0]}_transient"
         assert differences(name, (DATA / f"{name}.xml").read_bytes(), xml) == []
         new, _, root = read_description(fmu)
-        assert new["law"].vr == 111 and new["casing_distortion"].vr == 112
+        # after the last variable of the list (issue 27's casing_lobe4.phase, value reference 119)
+        assert new["example_law"].vr == 120 and new["casing_distortion"].vr == 121
         assert ("blade.F_wear" if fmi == "3.0" else "blade[10].F_wear") in new
-        assert "#define VR_LAW 111" in header and "#define VR_BLADE_F_WEAR 113" in header
-        assert "#define LAW_POWER 2" in header
+        assert "#define VR_EXAMPLE_LAW 120" in header and "#define VR_BLADE_F_WEAR 122" in header
+        assert "#define EXAMPLELAW_POWER 2" in header
         if fmi == "3.0":
-            assert new["blade.F_wear"].vr == 113
+            assert new["blade.F_wear"].vr == 122
             dims = [d.get("valueReference") for d in root.iter("Float64") if d.get("name") == "blade.F_wear"
                     for d in d.iter("Dimension")]
             assert dims == [str(new["n_blades"].vr)]
         else:
-            assert [new[f"blade[{k}].F_wear"].vr for k in (1, 10)] == [113, 122]
+            assert [new[f"blade[{k}].F_wear"].vr for k in (1, 10)] == [122, 131]

@@ -1,8 +1,9 @@
 """RotorCasingContact's FMI cross-check kit, written next to each FMU (the files: fmu_src/fmi/crosscheck.py):
 
 * ``RotorCasingContact_in.csv``: every input of the FMU, one row per communication point: ``time, Omega,
-  imbalance, clearance_closure, casing_offset.x, casing_offset.y`` (a run-up through the first critical speed
-  with the reference imbalance; the engine's inputs at their start values, 0);
+  imbalance, clearance_closure, casing_offset.x, casing_offset.y, casing_lobe2.amplitude, ...`` (a run-up through
+  the first critical speed with the reference imbalance; half-way the engine ovalizes the casing: lobe 2 steps to
+  ``RUN["oval"]`` at ``RUN["oval_phase"]``; the other engine inputs at their start values, 0);
 * ``RotorCasingContact_ref.csv``: the reference outputs at the same points (FMI 3.0 kit: the per-blade outputs in
   the array columns, ``blade.F_N[1]``, ...);
 * ``RotorCasingContact_ref.opt`` and ``ReadMe.txt``.
@@ -23,7 +24,8 @@ from ...fmi.variables import declared, scalars
 from . import variables as cv
 
 NAME = cv.MODEL_IDENTIFIER
-RUN = {"speed_from": 3.2, "speed_to": 3.8, "duration": 2.0, "h": 1e-3}  # normalised speeds; s
+RUN = {"speed_from": 3.2, "speed_to": 3.8, "duration": 2.0, "h": 1e-3,  # normalised speeds; s
+       "oval_at": 1.0, "oval": 0.3e-3, "oval_phase": 0.5}  # s; m (against the kit's 1 mm clearance); rad
 
 
 def outputs(n_blades: int = 10) -> tuple[str, ...]:
@@ -49,17 +51,24 @@ def reference(params=None) -> dict[str, np.ndarray]:
     """Every input (by name) and the reference outputs (FMI 2.0 names) at the communication points 0, h, ..."""
     from rotorub_model.analyses.transient import run_transient
     from rotorub_model.contact import make_contact
+    from rotorub_model.contact.liner import Liner
     from rotorub_model.structure.model import build_model
     from rotorub_model.structure.params import reference_parameters
 
     p = params or reference_parameters()
     m = build_model(p)
     w = _omega(p.normalisation.omega_ref)
-    h, T = RUN["h"], RUN["duration"]
-    r = run_transient(m, make_contact(m, "3D"), w, t_end=T, t_ramp=0.0, me=p.imbalance.me, record_dt=h, hold=h)
-    n = len(r.t)
-    t = np.concatenate([[0.0], r.t])
-    o = r.outputs
+    h, T, t1 = RUN["h"], RUN["duration"], RUN["oval_at"]
+    c = make_contact(m, "3D")
+    # the casing as the FMU holds it: round until t1, then oval (a rigid surface, the engine's input at a step)
+    casing = Liner(c, wears=False)
+    first = run_transient(m, c, w, t_end=t1, t_ramp=0.0, me=p.imbalance.me, record_dt=h, hold=h, liner=casing)
+    casing.set_distortion({2: (RUN["oval"], RUN["oval_phase"])})
+    second = run_transient(m, c, w, t_end=T - t1, t_ramp=0.0, me=p.imbalance.me, record_dt=h, hold=h,
+                           liner=casing, start=first.final_state)
+    n = len(first.t) + len(second.t)
+    t = np.concatenate([[0.0], first.t, second.t])
+    o = {k: np.concatenate([first.outputs[k], second.outputs[k]]) for k in first.outputs}
     out = {"time": t}
     # every input of the FMU: the run's speed and imbalance, the others held at their start values
     for v in scalars(declared(_variables(p), ("fmi2", "native"))):
@@ -67,6 +76,9 @@ def reference(params=None) -> dict[str, np.ndarray]:
             out[v.name] = np.full(n + 1, float(v.start))
     out["Omega"] = np.array([w(x) for x in t])
     out["imbalance"] = np.full(n + 1, p.imbalance.me)
+    # held over the step that starts at each row: the row at t1 starts the oval casing's first step
+    out["casing_lobe2.amplitude"] = np.where(t >= t1 - 0.5 * h, RUN["oval"], 0.0)
+    out["casing_lobe2.phase"] = np.full(n + 1, RUN["oval_phase"])
     zero = np.zeros(1)
     out["friction_torque"] = np.concatenate([zero, o["friction_torque"]])
     out["gap_min"] = np.concatenate([[p.contact.g0], o["gap"].min(axis=(1, 2))])
@@ -101,7 +113,9 @@ def write_kit(dest: str | Path, params=None, fmi: str = "2.0") -> dict[str, Path
 
 A run-up with blade-tip / casing rub: the spin speed Omega rises linearly from {RUN['speed_from']} to
 {RUN['speed_to']} x omega_ref (through the first critical speed) in {RUN['duration']} s, the imbalance is held at
-the reference value, the engine's inputs ({', '.join(i for i in inputs if i not in ('Omega', 'imbalance'))}) at 0,
+the reference value; at t = {RUN['oval_at']} s the engine ovalizes the casing (casing_lobe2.amplitude steps to
+{RUN['oval'] * 1e3:g} mm, casing_lobe2.phase {RUN['oval_phase']:g} rad); the engine's other inputs
+({', '.join(i for i in inputs if i not in ('Omega', 'imbalance') and not i.startswith('casing_lobe2'))}) stay 0;
 every parameter keeps its default (3D contact, transient mode, g0 = 1 mm).
 
 Run {NAME}.fmu from 0 to {RUN['duration']} s with a fixed communication step of {RUN['h']} s, the inputs of

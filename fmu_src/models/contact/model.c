@@ -71,7 +71,7 @@ void model_free(model_runtime *m)
 static double critical_step(model_runtime *m, double w)
 {
     const model_data *d = &MODEL_DATA;
-    rr_k_omega(m->n, d->K, d->S2, d->N2, d->C1, w, m->Kw);
+    rr_k_omega(m->n, d->K, d->S2, d->N2, d->C1, NULL, w, m->Kw);
     return rr_critical_step(&m->contact, w, m->Minv, m->Kw, m->Aeig); /* Aeig: 4 n^2 of scratch */
 }
 
@@ -164,6 +164,18 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
     m->contact.A = m->geo.A;
     m->contact.B = m->geo.B;
     m->contact.v_slip = m->v_slip;
+    /* the normal law: the kernel's one dispatch (rr_laws.c), the same as the library's */
+    m->contact.law.id = v->i[VR_LAW] == LAW_BILINEAR ? RR_LAW_BILINEAR : RR_LAW_PENALTY;
+    if (m->contact.law.id == RR_LAW_BILINEAR) {
+        m->contact.law.par[RR_BILINEAR_KNEE] = v->r[VR_KNEE];
+        m->contact.law.par[RR_BILINEAR_RATIO] = v->r[VR_STIFFNESS_RATIO];
+    }
+    if (rr_law_check(&m->contact.law) != 0) {
+        snprintf(msg, len, "the normal law's parameters are refused (knee %g m, stiffness_ratio %g)", v->r[VR_KNEE],
+                 v->r[VR_STIFFNESS_RATIO]);
+        model_free(m);
+        return NULL;
+    }
     m->contact.S = m->geo.S;
     m->contact.points = m->geo.points;
     m->contact.normals = m->geo.normals;
@@ -326,11 +338,19 @@ static void wear_outputs(model_runtime *m, model_values *v)
  * nonzero. Once worn, the liner stays attached (its depths are nonzero) */
 static void attach_surface(model_runtime *m, const model_values *v)
 {
+    static const int amp_vr[] = {VR_CASING_LOBE2_AMPLITUDE, VR_CASING_LOBE3_AMPLITUDE, VR_CASING_LOBE4_AMPLITUDE};
+    static const int phase_vr[] = {VR_CASING_LOBE2_PHASE, VR_CASING_LOBE3_PHASE, VR_CASING_LOBE4_PHASE};
+    int k, lobes = 0;
     m->surf.closure = v->r[VR_CLEARANCE_CLOSURE];
     m->surf.offset_x = v->r[VR_CASING_OFFSET_X];
     m->surf.offset_y = v->r[VR_CASING_OFFSET_Y];
+    for (k = 0; k < 3; ++k) { /* lobes 2, 3, 4: the casing out of round */
+        m->surf.lobe_amp[k + 2] = v->r[amp_vr[k]];
+        m->surf.lobe_phase[k + 2] = v->r[phase_vr[k]];
+        if (m->surf.lobe_amp[k + 2] != 0.0) lobes = 1;
+    }
     m->contact.surface = m->surf.wears || m->surf.closure != 0.0 || m->surf.offset_x != 0.0 ||
-                                 m->surf.offset_y != 0.0
+                                 m->surf.offset_y != 0.0 || lobes
                              ? &m->surf
                              : NULL;
 }
@@ -351,7 +371,7 @@ static model_status transient_step(model_runtime *m, model_values *v, double w, 
     dt = h / ns;
     /* the matrices first: a step refused here leaves the state as it was (the two-step scheme untouched) */
     if (!m->have_mats || m->mats_omega != w || m->mats_dt != dt) {
-        if (rr_cd_build(n, d->M, d->D, d->K, d->G1, d->C1, d->N2, d->S2, NULL, w, 0.0, dt, m->Ainv, m->K2, m->Cm1,
+        if (rr_cd_build(n, d->M, d->D, d->K, d->G1, d->C1, d->N2, d->S2, NULL, NULL, w, 0.0, dt, m->Ainv, m->K2, m->Cm1,
                         m->mwork, m->piv) != 0) {
             m->have_mats = 0; /* the buffers hold a failed build */
             snprintf(msg, len, "the central-difference matrix is singular at %g rad/s, dt = %g s", w, dt);
@@ -408,7 +428,7 @@ static model_status static_solution(model_runtime *m, model_values *v, double w,
     double rel, gmin, max_real = -HUGE_VAL;
     double *q = m->Ainv; /* the transient buffers are free in this mode: the candidate solution */
     double *J = m->K2, *A = m->Aeig, *C = m->Cm1;
-    rr_k_omega(m->n, d->K, d->S2, d->N2, d->C1, w, m->Kw);
+    rr_k_omega(m->n, d->K, d->S2, d->N2, d->C1, NULL, w, m->Kw);
     for (i = 0; i < n; ++i) m->Fw[i] = me * w * w * d->f_unit[i];
     m->contact.g0 = m->g0 - v->r[VR_CLEARANCE_CLOSURE]; /* the engine's closure: uniform, so a balanced solution still is */
     ok = rr_static_solve(&m->contact, w, m->Kw, m->Fw, m->have_qs ? m->qs : NULL, 1e-10, 60, q, &rel, &its, m->swork,
@@ -541,12 +561,17 @@ model_status model_solve_now(model_runtime *m, model_values *v, double t, char *
 
 /* ------------------------------------------------------------------ state snapshots */
 /* layout: tag, n, formulation, mode, g0, t, dt, phi, steps, diverged, have_qs, phi_qs, the liner's angle and
- * plastic work, its cells' count, q, qp, qs, the liner's depths (np x n_sectors) */
+ * plastic work, its cells' count, q, qp, qs, the liner's depths (np x n_sectors), the engine's inputs the liner was
+ * last cut at (NaN before the first cut: a rollback to then cuts at the next step's inputs first) */
 #define STATE_HEAD 15
+#define STATE_CUT ((int)(sizeof(((rr_surface *)0)->cut_inputs) / sizeof(double)))
 
 static size_t liner_cells(const model_runtime *m) { return (size_t)m->np * m->surf.n_sectors; }
 
-size_t model_state_size(const model_runtime *m) { return STATE_HEAD + 3 * (size_t)m->n + liner_cells(m); }
+size_t model_state_size(const model_runtime *m)
+{
+    return STATE_HEAD + 3 * (size_t)m->n + liner_cells(m) + STATE_CUT;
+}
 
 void model_state_save(const model_runtime *m, double *out)
 {
@@ -573,6 +598,7 @@ void model_state_save(const model_runtime *m, double *out)
         out[STATE_HEAD + 2 * n + i] = m->qs[i];
     }
     for (k = 0; k < liner_cells(m); ++k) out[STATE_HEAD + 3 * (size_t)n + k] = m->surf.depth[k];
+    for (i = 0; i < STATE_CUT; ++i) out[STATE_HEAD + 3 * (size_t)n + liner_cells(m) + i] = m->surf.cut_inputs[i];
 }
 
 int model_state_restore(model_runtime *m, const double *in, size_t count)
@@ -583,8 +609,10 @@ int model_state_restore(model_runtime *m, const double *in, size_t count)
         in[3] != m->mode || !(in[6] >= 0.0) || !(in[8] >= 0.0) || (in[9] != 0.0 && in[9] != 1.0) ||
         (in[10] != 0.0 && in[10] != 1.0) || in[14] != (double)cells || !(in[13] >= 0.0))
         return -1;
-    for (i = 4; i < (int)count; ++i)
+    for (i = 4; i < (int)count - STATE_CUT; ++i)
         if (!isfinite(in[i])) return -1;
+    for (i = (int)count - STATE_CUT; i < (int)count; ++i) /* never cut (NaN) or a finite input */
+        if (isinf(in[i])) return -1;
     for (k = 0; k < cells; ++k)
         if (!(in[STATE_HEAD + 3 * (size_t)n + k] >= 0.0)) return -1; /* a worn depth is never negative */
     set_clearance(m, in[4]);
@@ -604,6 +632,7 @@ int model_state_restore(model_runtime *m, const double *in, size_t count)
     m->surf.plastic_work = in[13];
     m->have_wear = 0; /* another profile: its summary is computed anew */
     for (k = 0; k < cells; ++k) m->surf.depth[k] = in[STATE_HEAD + 3 * (size_t)n + k];
+    for (i = 0; i < STATE_CUT; ++i) m->surf.cut_inputs[i] = in[STATE_HEAD + 3 * (size_t)n + cells + i];
     m->have_mats = 0; /* dt may differ */
     return 0;
 }

@@ -88,19 +88,28 @@ class RotorCasingContact(Fmi2Slave):
         self.copyright = "rotorub developers"
         self._ref = self._lib.params.from_dict(self._manifest["parameter_values"])
         self._feedthrough = bool(self._manifest.get("feedthrough", False))
-        self._vars = [SimpleNamespace(**v) for v in self._manifest["variables"]]  # FMI 2.0 view, vr order
+        # the FMI 2.0 view indexed by value reference; the numbering keeps the gaps of the other builds' variables
+        # (the FMI 3.0 FMU's own before later additions): placeholders there, never registered
+        declared = [SimpleNamespace(**v) for v in self._manifest["variables"]]
+        self._vars = [SimpleNamespace(name=None, type="Gap", causality="gap", variability=None, start=None, min=None,
+                                      max=None, vr=k) for k in range(max(v.vr for v in declared) + 1)]
+        for v in declared:
+            self._vars[v.vr] = v
         self.guid = self._manifest["guid"]  # derived from the model at build time, not pythonfmu's uuid1()
         n = len(self._vars)
-        self._slot = {v.name: i for i, v in enumerate(self._vars)}
+        self._slot = {v.name: i for i, v in enumerate(self._vars) if v.name is not None}
         self._rv = np.zeros(n)
         self._iv = np.zeros(n, dtype=np.int64)
         self._sv = [""] * n
         self._is_real = np.array([v.type == "Real" for v in self._vars])
         self._is_int = np.array([v.type in ("Integer", "Enumeration") for v in self._vars])
+        self._lobe_names = [(n, f"casing_lobe{n}.amplitude", f"casing_lobe{n}.phase") for n in (2, 3, 4)]
         self._real_inputs = frozenset(self._slot[k] for k in ("Omega", "imbalance", "g0", "clearance_closure",
-                                                              "casing_offset.x", "casing_offset.y"))
+                                                              "casing_offset.x", "casing_offset.y",
+                                                              *(x for _, a, p in self._lobe_names for x in (a, p))))
         for i, v in enumerate(self._vars):
-            self._register(i, v)
+            if v.name is not None:
+                self._register(i, v)
         self._set_starts()
         nb = self._ref.blades.count
         # where the kernel writes each output of a state (its layout -> this slave's value buffer);
@@ -116,6 +125,7 @@ class RotorCasingContact(Fmi2Slave):
         self._i_gmin = s["gap_min"]
         self._i_closure, self._i_offx, self._i_offy = s["clearance_closure"], s["casing_offset.x"], s["casing_offset.y"]
         self._i_clear = s["clearance_effective"]
+        self._i_lobes_in = [(n, s[a], s[p]) for n, a, p in self._lobe_names]
         # the kernel's summary, in its order (kernel.WEAR_NAMES: depth_max, ..., lobes, harmonic_1, ...)
         names = kern.WEAR_NAMES
         wear = [f"wear.harmonic[{n.rpartition('_')[2]}]" if n.startswith("harmonic_") else f"wear.{n}" for n in names]
@@ -148,8 +158,9 @@ class RotorCasingContact(Fmi2Slave):
         var = cls(v.name, causality=Fmi2Causality[v.causality], variability=Fmi2Variability[v.variability],
                   description=v.description, initial=initial, getter=getter,
                   setter=None if v.causality == "output" else setter)
-        self.register_variable(var, nested=False)
-        assert var.value_reference == i
+        # at the value reference the model description declares (pythonfmu would number in registration order)
+        var.value_reference = i
+        self.vars[i] = var
 
     def _set_starts(self) -> None:
         for i, v in enumerate(self._vars):
@@ -331,6 +342,11 @@ class RotorCasingContact(Fmi2Slave):
                     f"{max_penetration * 1e3:.6g} mm is a divergence (accepted: g0 >= -max_penetration)")
         return None
 
+    def _distortion(self) -> dict:
+        """The casing's lobes from the engine's inputs, as the liner takes them (a lobe of amplitude 0 is round)."""
+        rv = self._rv
+        return {n: (float(rv[a]), float(rv[p])) for n, a, p in self._i_lobes_in if rv[a] != 0.0}
+
     def _configuration_error(self, msg: str) -> None:
         self._fatal_msg = msg
         self._sim = None
@@ -343,8 +359,10 @@ class RotorCasingContact(Fmi2Slave):
                 "mode": enum["Mode"][self._i("mode") - 1][0],
                 "param_file": self._sv[self._slot["param_file"]],
                 **{k: self._r(k) for k in ("k_r", "mu", "theta", "chord", "dt_max", "max_penetration",
-                                                     "slip_velocity", "yield_force", "hardening", "liner_thickness")},
-                "liner": enum["Liner"][self._i("liner") - 1][0], "n_sectors": self._i("n_sectors")}
+                                                     "slip_velocity", "yield_force", "hardening", "liner_thickness",
+                                                     "knee", "stiffness_ratio")},
+                "liner": enum["Liner"][self._i("liner") - 1][0], "n_sectors": self._i("n_sectors"),
+                "law": enum["Law"][self._i("law") - 1][0]}
 
     def _build(self, config: dict | None = None, provisional: bool = False) -> None:
         """Build model, contact and solver from the parameters (raises with a message naming the cause);
@@ -368,7 +386,8 @@ class RotorCasingContact(Fmi2Slave):
         params = params.replace(contact={"g0": g0, "k_r": cfg["k_r"], "mu": cfg["mu"],
                                          "theta_deg": math.degrees(cfg["theta"]), "chord": cfg["chord"],
                                          "max_penetration": cfg["max_penetration"],
-                                         "slip_velocity": cfg["slip_velocity"]})
+                                         "slip_velocity": cfg["slip_velocity"], "law": cfg["law"],
+                                         "knee": cfg["knee"], "stiffness_ratio": cfg["stiffness_ratio"]})
         if path:
             try:  # assembling a model needs scipy (the shaft's component modes)
                 model = lib.model.build_model(params)
@@ -378,7 +397,8 @@ class RotorCasingContact(Fmi2Slave):
                     from None
         else:  # the matrices baked at build time: no assembly, numpy only
             model = lib.model.load_model(self._resources / self._manifest["model"], params)
-        contact = lib.contact.make_contact(model, cfg["formulation"])
+        contact = lib.contact.make_contact(model, cfg["formulation"], law=cfg["law"], knee=cfg["knee"],
+                                           stiffness_ratio=cfg["stiffness_ratio"])
         sim = {"config": cfg, "model": model, "contact": contact, "g0": g0, "phi": 0.0, "q_static": None,
                "limit": (None, None), "plan": (None, None, 0), "transient": cfg["mode"] == "transient"}
         # the casing's surface: the liner (worn or rigid) and the engine's closure and offset; its cells' area
@@ -389,8 +409,8 @@ class RotorCasingContact(Fmi2Slave):
                                        band=cfg["chord"] * math.cos(math.radians(params.blades.stagger_deg)),
                                        tip_area=params.blades.thickness * cfg["chord"])
         closure, offset = self._r("clearance_closure"), (self._r("casing_offset.x"), self._r("casing_offset.y"))
-        sim["liner"].set_inputs(closure, offset)
-        surface = sim["liner"].wears or closure != 0.0 or offset != (0.0, 0.0)
+        sim["liner"].set_inputs(closure, offset, self._distortion())
+        surface = not sim["liner"].is_neutral
         if sim["transient"]:
             sim["cd"] = lib.transient.CentralDifference(model, contact, dt=None, t_ramp=0.0,
                                                         max_penetration=cfg["max_penetration"],
@@ -507,10 +527,11 @@ class RotorCasingContact(Fmi2Slave):
         rv, iv = self._rv, self._iv
         liner = self._sim["liner"]
         closure, offset = float(rv[self._i_closure]), (float(rv[self._i_offx]), float(rv[self._i_offy]))
-        if closure != liner.closure or offset != liner.offset:  # ctypes writes only when the engine moved
-            liner.set_inputs(closure, offset)
-        # as the native FMU: the surface only when it adds something (worn or wearing, closure or offset)
-        on = liner.wears or closure != 0.0 or offset != (0.0, 0.0)
+        distortion = self._distortion()
+        if closure != liner.closure or offset != liner.offset or distortion != liner.distortion:
+            liner.set_inputs(closure, offset, distortion)  # ctypes writes only when the engine moved
+        # as the native FMU: the surface only when it adds something (worn or wearing, closure, offset, lobes)
+        on = liner.wears or closure != 0.0 or offset != (0.0, 0.0) or bool(distortion)
         if on != cd.liner_on:
             cd.use_liner(on)
         done, _ = cd.advance(n, omega, me)  # the kernel writes the outputs into self._rv (bind_outputs)

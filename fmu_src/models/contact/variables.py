@@ -21,6 +21,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from rotorub_model.structure.params import accepted_range
+
 from ...fmi.description import ModelInfo
 from ...fmi.variables import TIME, Var, numbered, tidy
 
@@ -39,6 +41,9 @@ ENUMERATIONS = {
              ("quasi_static", "the balanced static solution at the held inputs, with its stability")),
     "Liner": (("rigid", "the paper's casing: rigid, never worn"),
               ("abradable", "an abradable liner, cut where a blade tip presses it beyond its yield force")),
+    "Law": (("penalty", "the paper's penalty law: F = k_r delta"),
+            ("bilinear", "a coating then a stiffer or softer layer: F = k_r delta + (stiffness_ratio - 1) k_r "
+                         "(delta - knee)_+")),
 }
 
 # unit -> (SI base-unit exponents, display units {name: factor}); display value = factor * value
@@ -89,6 +94,9 @@ class Defaults:
     hardening: float = 0.0  # [N/m]
     liner_thickness: float = 2.0e-3  # [m]
     n_sectors: int = 720
+    law: str = "penalty"  # the parameter file's contact.law
+    knee: float = 0.5e-3  # [m]
+    stiffness_ratio: float = 4.0
 
     @classmethod
     def from_parameters(cls, p) -> Defaults:
@@ -100,25 +108,32 @@ class Defaults:
                    mu=p.contact.mu, theta=math.radians(p.contact.theta_deg), chord=p.contact.chord,
                    max_penetration=p.contact.max_penetration, slip_velocity=p.contact.slip_velocity,
                    liner=p.abradable.enabled, yield_force=p.abradable.yield_force, hardening=p.abradable.hardening,
-                   liner_thickness=p.abradable.thickness, n_sectors=p.abradable.n_sectors)
+                   liner_thickness=p.abradable.thickness, n_sectors=p.abradable.n_sectors, law=p.contact.law,
+                   knee=p.contact.knee, stiffness_ratio=p.contact.stiffness_ratio)
 
 
-# ranges that are modelling judgements (the descriptions say why); g0's lower end is the built-in
-# max_penetration: a deeper interference is a divergence at t = 0
-G0_MAX = 0.1
-K_R_RANGE = (1e3, 1e10)
-MU_RANGE = (0.0, 1.0)
-THETA_RANGE = (0.0, math.radians(60.0))
-CHORD_RANGE = (1e-3, 0.5)
+# ranges: the library's one declaration (rotorub_model.structure.params, field metadata and INPUT_RANGES), read here
+# as the parameter file and the CLI read it; g0's lower end is the built-in max_penetration (a deeper interference
+# diverges at t = 0); dt_max's is the FMU's own (no parameter-file counterpart)
+G0_MAX = accepted_range("g0_max")[1]
+K_R_RANGE = accepted_range("contact.k_r")
+MU_RANGE = accepted_range("contact.mu")
+THETA_RANGE = tuple(math.radians(v) for v in accepted_range("contact.theta_deg"))
+CHORD_RANGE = accepted_range("contact.chord")
 DT_MAX_RANGE = (1e-8, 1.0)
-PENETRATION_RANGE = (1e-5, 0.05)
-SLIP_RANGE = (1e-4, 10.0)
-CLOSURE_RANGE = (-0.01, 0.01)  # +-10 mm: an engine's thermal and centrifugal growth, with margin
-OFFSET_RANGE = (-0.01, 0.01)
-YIELD_RANGE = (1e-3, 1e7)
-HARDENING_RANGE = (0.0, 1e10)
-THICKNESS_RANGE = (1e-5, 0.05)
-SECTORS_RANGE = (8, 100000)
+PENETRATION_RANGE = accepted_range("contact.max_penetration")
+SLIP_RANGE = accepted_range("contact.slip_velocity")
+CLOSURE_RANGE = accepted_range("clearance_closure")
+OFFSET_RANGE = accepted_range("casing_offset")
+YIELD_RANGE = accepted_range("abradable.yield_force")
+HARDENING_RANGE = accepted_range("abradable.hardening")
+THICKNESS_RANGE = accepted_range("abradable.thickness")
+SECTORS_RANGE = tuple(int(v) for v in accepted_range("abradable.n_sectors"))
+KNEE_RANGE = accepted_range("contact.knee")
+RATIO_RANGE = accepted_range("contact.stiffness_ratio")
+LOBE_AMPLITUDE_RANGE = accepted_range("casing_lobe_amplitude")
+LOBE_PHASE_RANGE = accepted_range("casing_lobe_phase")
+FMU_LOBES = (2, 3, 4)  # the casing's lobes an engine can drive (the kernel has up to 8: the library takes them all)
 WEAR_HARMONICS = 8  # the kernel's RR_WEAR_HARMONICS
 
 
@@ -271,8 +286,8 @@ def variables(d: Defaults, mode: str = "transient") -> list[Var]:
     add(Var("wear.plastic_work", "Real", "output", "discrete", "Work dissipated in removing the liner",
             unit="J"))
     add(Var("wear.lobes", "Integer", "output", "discrete",
-            "Dominant lobe count of the worn profile: the harmonic 1-8 of largest amplitude (0: no wear, or worn "
-            "evenly: no harmonic reaches 1 % of the mean depth)"))
+            "Dominant lobe count of the worn profile (0: no wear; worn evenly, every harmonic below 5 % of the mean "
+            "depth; or no harmonic at least twice every harmonic that is not its multiple)"))
     add(Var("wear.harmonic", "Real", "output", "discrete",
             "Amplitudes of the worn profile's harmonics 1 to 8 (element h: h lobes): the worn profile as a fixed, "
             "small set of outputs whatever n_sectors", unit="m", display_unit="mm", size=WEAR_HARMONICS,
@@ -291,6 +306,29 @@ def variables(d: Defaults, mode: str = "transient") -> list[Var]:
             "gap_min + max_penetration: how far the deepest blade is from the divergence depth (the event indicator "
             "of a divergence: it crosses 0 downwards when the run diverges)", unit="m", display_unit="mm",
             sum_of=("gap_min", "max_penetration"), event_indicator=True, only="fmi3"))
+    # the normal law (issue 24) and the casing out of round (issue 27): after every earlier variable
+    add(Var("law", "Enumeration", "parameter", "fixed",
+            "Normal contact law: penalty (the paper's) or bilinear (stiffness k_r up to the knee penetration, "
+            "stiffness_ratio x k_r beyond)", start=1 + ("penalty", "bilinear").index(d.law), min=1, max=2,
+            declared_type="Law"))
+    add(Var("knee", "Real", "parameter", "fixed",
+            "Bilinear law: the penetration where the stiffness changes", unit="m", display_unit="mm", start=d.knee,
+            min=KNEE_RANGE[0], max=KNEE_RANGE[1], nominal=5e-4))
+    add(Var("stiffness_ratio", "Real", "parameter", "fixed",
+            "Bilinear law: the stiffness beyond the knee over k_r (> 1 stiffens, < 1 softens; the internal step "
+            "shrinks as 1/sqrt of the largest slope)", unit="1", start=d.stiffness_ratio, min=RATIO_RANGE[0],
+            max=RATIO_RANGE[1], nominal=1.0))
+    for n in FMU_LOBES:
+        add(Var(f"casing_lobe{n}.amplitude", "Real", "input", "continuous",
+                f"The casing out of round with {n} lobes (from the engine: thermal gradients, mounts, manoeuvre "
+                f"loads): its inner radius grows by amplitude cos({n} (theta - phase)), theta the fixed-frame angle; "
+                "> 0 opens the gap at the lobes' maxima. Held over each step (transient mode)", unit="m",
+                display_unit="mm", start=0.0, min=LOBE_AMPLITUDE_RANGE[0], max=LOBE_AMPLITUDE_RANGE[1],
+                nominal=1e-4, feedthrough=False))
+        add(Var(f"casing_lobe{n}.phase", "Real", "input", "continuous",
+                f"Fixed-frame angle of a maximum of the casing's {n}-lobe out-of-roundness", unit="rad",
+                display_unit="deg", start=0.0, min=LOBE_PHASE_RANGE[0], max=LOBE_PHASE_RANGE[1], nominal=1.0,
+                feedthrough=False))
     # new variables go here, after every earlier one (their value references stay as they are)
     return numbered(V)
 
