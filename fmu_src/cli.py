@@ -16,9 +16,12 @@ def _add_build_args(sp: argparse.ArgumentParser) -> None:
                          "return at a first contact) instead of the FMI 2.0 one")
     sp.add_argument("--mode", default="transient", choices=["transient", "quasi_static"],
                     help="default of the mode parameter, and the output dependencies the FMU declares")
+    from .fmi.compile import ALL_PLATFORMS  # light: the builder itself is imported only to build
+
     sp.add_argument("--platforms", nargs="+", default=None,
-                    help="platforms to build (native: linux64 win64 darwin64 aarch64-darwin; pythonfmu kernel: "
-                         "linux64 win64); default: this one plus what ziglang can cross-compile")
+                    help=f"platforms to build (native: {' '.join(ALL_PLATFORMS)}; pythonfmu kernel: linux64 win64, "
+                         "the platforms pythonfmu 0.7 has a binary for); default: all of them when ziglang is "
+                         "installed, else this machine's")
 
 
 def build(dest: str | Path, params: str | Path | None = None, native: bool = False, mode: str = "transient",
@@ -53,18 +56,35 @@ def _run_build(ns: argparse.Namespace) -> dict:
     default = Path("fmus") / (("native-fmi3" if ns.fmi3 else "native") if ns.native else "")
     dest = default if ns.out == "out/build-fmu" else Path(ns.out)
     try:
-        return build(dest, ns.params, ns.native, ns.mode, tuple(ns.platforms) if ns.platforms else None, ns.fmi3)
+        r = build(dest, ns.params, ns.native, ns.mode, tuple(ns.platforms) if ns.platforms else None, ns.fmi3)
     except (BuildError, NativeBuildError, CompilerError) as exc:
         raise ParameterError(f"build-fmu: {exc}") from None
+    plats = r.get("platforms") or r.get("kernel_platforms") or []
+    flavour = ("native C, FMI 3.0" if ns.fmi3 else "native C, FMI 2.0") if ns.native else "pythonfmu, FMI 2.0"
+    r["verdict"] = [f"Built {r['fmu']} ({flavour} co-simulation, mode {ns.mode}"
+                    + (f", {r['variables']} variables" if "variables" in r else "")
+                    + (f", binaries for {', '.join(plats)}" if plats else "") + ").",
+                    f"cross-check kit next to it: {', '.join(Path(k).name for k in r.get('crosscheck_kit', []))}"]
+    return r
 
 
 def reproduce_fmu_part(model, out: str | Path, summary: dict, quick: bool, fmu_dir: str | Path = "fmus",
-                       params_file: str | Path | None = None, progress: bool = True) -> dict:
-    """The FMU half of ``rotorub reproduce`` (reproduce.py): returns ``{"summary": ..., "markdown": ...}``, the
-    additions to the summary and the report's section about them."""
+                       params_file: str | Path | None = None, progress: bool = True, builds=None) -> dict:
+    """The FMU half of ``rotorub reproduce`` (reproduce.py): returns ``{"summary": ..., "markdown": ...,
+    "verdict": ...}``, the additions to the summary, the report's section about them and the verdict's lines;
+    ``builds``: what :func:`start_fmu_builds` returned, when the FMUs were started before the library's analyses."""
     from .reproduce import run_fmu_part
 
-    return run_fmu_part(model, out, summary, quick, fmu_dir=fmu_dir, params_file=params_file, progress=progress)
+    return run_fmu_part(model, out, summary, quick, fmu_dir=fmu_dir, params_file=params_file, progress=progress,
+                        builds=builds)
+
+
+def start_fmu_builds(fmu_dir: str | Path = "fmus", params_file: str | Path | None = None):
+    """Start building the main job's FMUs in the background (entry point ``rotorub.reproduce: fmu-builds``): the
+    compilations run beside the library's analyses. Returns the handle :func:`reproduce_fmu_part` takes."""
+    from .reproduce import start_builds
+
+    return start_builds(fmu_dir, params_file)
 
 
 # (name, help, add_arguments, run): what rotorub_model.app.cli registers for each entry point

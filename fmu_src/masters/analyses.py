@@ -26,7 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rotorub_model.results import pyplot, save_figure, write_json
+from rotorub_model.plotting import pyplot, save_figure
+from rotorub_model.writing import write_json
 
 from .fmi2 import Slave
 
@@ -90,10 +91,11 @@ class QuasiStaticMaps:
         out["vs_library"] = self.comparison
         return out
 
-    def plot(self, path: str | Path) -> Path:
-        """Blades in contact per cell (a discrete colour scale); unstable cells hatched cell by cell (a
-        contour of the boolean spilled the hatch half a cell into its neighbours, in lines a cell apart);
-        cells the FMU found no balanced solution for in grey."""
+    def figure(self):
+        """Blades in contact per cell (one discrete colour scale for both panels); unstable cells hatched cell by
+        cell (a contour of the boolean spilled the hatch half a cell into its neighbours, in lines a cell apart);
+        cells the FMU found no balanced solution for in grey; the clearance axis ends just above the highest
+        contact cell (the grid goes on, without contact, to its top, which the title gives)."""
         from matplotlib.colors import BoundaryNorm, ListedColormap
         from matplotlib.patches import Patch, Rectangle
 
@@ -125,8 +127,33 @@ class QuasiStaticMaps:
         if any((n < 0).any() for n in self.n_contact.values()):
             handles.append(Patch(facecolor=NO_SOLUTION_COLOUR, label="no balanced solution found (FMU step discarded)"))
         fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8.5, frameon=False)
+        top = _contact_top(self.g0s * 1e3, [n != 0 for n in self.n_contact.values()])
+        if top is not None and top < ge[-1]:
+            axes[0].set_ylim(ge[0], top)
+            fig.suptitle(f"clearance axis cut at {top:.3g} mm: no contact above, up to the grid's "
+                         f"{self.g0s[-1] * 1e3:.3g} mm", fontsize=8.5)
         fig.tight_layout(rect=(0, 0.07, 1, 1))
-        return save_figure(fig, path, layout=False)
+        return fig
+
+    def save(self, out: str | Path) -> dict:
+        """fmu_maps.png and summary.json in ``out``; returns the summary."""
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        save_figure(self.figure(), out / "fmu_maps.png", layout=False)
+        s = self.summary()
+        write_json(out / "summary.json", s)
+        return s
+
+
+def _contact_top(g0_mm: np.ndarray, touching: list[np.ndarray]) -> float | None:
+    """Where a map's clearance axis should end: a cell and a quarter above the highest clearance at which any
+    speed of any panel has a cell other than 'no contact' (None: nothing to show)."""
+    rows = [np.flatnonzero(t.any(axis=0)) for t in touching]
+    j = max((int(r.max()) for r in rows if r.size), default=None)
+    if j is None:
+        return None
+    step = g0_mm[min(j + 1, len(g0_mm) - 1)] - g0_mm[j] if j + 1 < len(g0_mm) else g0_mm[j] - g0_mm[j - 1]
+    return float(g0_mm[j] + 1.25 * step)
 
 
 UNSTABLE_HATCH = "//////"  # six strokes per hatch unit: a few per cell even on a fine map
@@ -262,9 +289,9 @@ def run_fmu_transient(fmu: str | Path, unzip: str, formulation: str, g0: float, 
 
 def force_growth(r: FMURun) -> dict:
     """Growth of the oscillation of the total normal force at the end of the run: the FMU's counterpart of
-    the library's state-envelope growth (rotorub_model.app.studies.envelope_growth, on the force's
-    peak-to-peak range), judged by the same verdict (studies.diverging)."""
-    from rotorub_model.app.studies import NO_GROWTH, envelope_growth
+    the library's state-envelope growth (rotorub_model.analyses.transient.envelope_growth, on the force's
+    peak-to-peak range), judged by the same verdict (envelope_grows)."""
+    from rotorub_model.analyses.transient import NO_GROWTH, envelope_growth
 
     return envelope_growth(r.t, r.F_N.sum(axis=1), kind="ptp") if len(r.t) else dict(NO_GROWTH)
 
@@ -275,16 +302,29 @@ def _rel_diff(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.abs(a[:m] - b[:m]).max() / scale) if m else 0.0
 
 
-def _plot_forces(runs: dict[str, FMURun], path: Path, title: str, diverged: dict[str, bool]) -> Path:
-    """One panel per formulation; a blade keeps its colour in every panel, legends right of the data."""
-    from rotorub_model.results import legend_outside, plot_blade_forces
+def _verdict(s: dict) -> str:
+    """A run's verdict in words, the two meanings apart (as in the library's transient figures)."""
+    g = s.get("envelope_growth") or {}
+    if s.get("penetration_limit_hit"):
+        return "diverged: the penetration limit was hit"
+    if g.get("factor") is None:
+        return "no growth verdict (a run shorter than 4 s)"
+    return (("diverged: " if s.get("envelope_growing") else "not diverging: ")
+            + f"force envelope ×{g['factor']:.3g} over {g['window_s'][0]:.3g}-{g['window_s'][1]:.3g} s "
+            f"({g['rate_per_s']:+.3g} 1/s)")
+
+
+def _plot_forces(runs: dict[str, FMURun], path: Path, title: str, verdicts: dict[str, str]) -> Path:
+    """One panel per formulation, its verdict in its title; a blade keeps its colour in every panel, legends right
+    of the data."""
+    from rotorub_model.plotting import legend_outside, plot_blade_forces
 
     plt = pyplot()
     fig, axes = plt.subplots(len(runs), 1, figsize=(9, 3 * len(runs)), sharex=True, squeeze=False)
     for ax, (f, r) in zip(axes[:, 0], runs.items()):
         plot_blade_forces(ax, r.t, r.F_N, lw=0.8)
         ax.set_ylabel("normal contact force F_N [N]")
-        ax.set_title(f"{f}: {title}" + (" — diverged" if diverged[f] else ""))
+        ax.set_title(f"{f}: {title}\n{verdicts[f]}", fontsize=9)
         ax.grid(alpha=0.3)
         legend_outside(ax)
     axes[-1, 0].set_xlabel("time [s]")
@@ -294,8 +334,7 @@ def _plot_forces(runs: dict[str, FMURun], path: Path, title: str, diverged: dict
 def transient_pair(fmu: str | Path, model, speed: float, g0: float, out: str | Path, t_end: float = 20.0,
                    t_ramp: float = 1.0, h: float = H_TRANSIENT, progress: bool = False) -> dict:
     """Section 6 through the FMU: 2D and 3D at (speed, g0), imbalance ramped over t_ramp by the master."""
-    from rotorub_model.analyses.transient import run_transient
-    from rotorub_model.app.studies import diverging
+    from rotorub_model.analyses.transient import envelope_grows, run_transient
     from rotorub_model.contact import make_contact
 
     out = Path(out)
@@ -317,20 +356,24 @@ def transient_pair(fmu: str | Path, model, speed: float, g0: float, out: str | P
         runs[f] = r
         i1 = min(int(round(1.0 / h)) - 1, len(r.t) - 1)
         growth = force_growth(r)
+        hit = bool(len(r.status) > len(r.t) and r.status[-1] == 1)
+        growing = envelope_grows(growth)
         summary[f] = {
-            "diverged": bool((len(r.status) > len(r.t) and r.status[-1] == 1)
-                             or diverging(growth)),
-            "force_oscillation_growth_after_ramp": growth,
+            # the two meanings apart, as in the library's transient JSON; diverged: either
+            "diverged": True if hit else growing,
+            "penetration_limit_hit": hit,
+            "envelope_growing": growing,
+            "envelope_growth": {**growth, "about": "the total normal force (peak to peak)"},
             "t_reached_s": float(r.t[-1]) if len(r.t) else 0.0,
             "blades_in_contact_at_1s": int((r.F_N[i1] > 0).sum()) if len(r.t) else 0,
             "max_normal_force_N": float(r.F_N.max()) if r.F_N.size else 0.0,
             "final_chord_fractions": r.fraction[-1].round(4).tolist() if len(r.t) else [],
             "seconds_fmu": r.seconds,
-            "library_diverged": bool(lib.diverged),
+            "library_penetration_limit_hit": bool(lib.penetration_limit_hit),
             "max_rel_diff_F_N_vs_library": _rel_diff(r.F_N, lib.outputs["F_N"]),
         }
     _plot_forces(runs, out / "fmu_contact_forces.png", f"normal contact forces through the FMU, "
-                 f"Ω = {speed:.3g} Ω_ref, g0 = {g0 * 1e3:.3g} mm", {f: summary[f]["diverged"] for f in runs})
+                 f"Ω = {speed:.3g} Ω_ref, g0 = {g0 * 1e3:.3g} mm", {f: _verdict(summary[f]) for f in runs})
     np.savez_compressed(out / "fmu_transients.npz", **{f"{f}_{k}": getattr(r, k) for f, r in runs.items()
                                                         for k in ("t", "F_N", "fraction", "friction_torque")})
     write_json(out / "summary.json", summary)
@@ -363,7 +406,7 @@ def run_up(fmu: str | Path, model, out: str | Path, speed_from: float = 2.6, spe
     lib = run_transient(model, make_contact(model, formulation, g0=g0), omega_of_t, t_end=duration, t_ramp=0.0,
                         me=me, record_dt=h, hold=h)
 
-    from rotorub_model.results import legend_outside, plot_blade_forces
+    from rotorub_model.plotting import legend_outside, plot_blade_forces
 
     plt = pyplot()
     fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
@@ -387,7 +430,7 @@ def run_up(fmu: str | Path, model, out: str | Path, speed_from: float = 2.6, spe
         "speed_of_peak_response": float(r.omega[k_peak] / w_ref) if len(r.t) else None,
         "max_normal_force_N": float(r.F_N.max()) if r.F_N.size else 0.0,
         "max_blades_in_contact": int((r.F_N > 0).sum(axis=1).max()) if r.F_N.size else 0,
-        "diverged": bool(len(r.status) > len(r.t) and r.status[-1] == 1),
+        "penetration_limit_hit": bool(len(r.status) > len(r.t) and r.status[-1] == 1),
         "seconds_fmu": r.seconds,
         "max_rel_diff_F_N_vs_library": _rel_diff(r.F_N, lib.outputs["F_N"]),
         "max_rel_diff_disk_vs_library": _rel_diff(r.disk, lib.outputs["disk_fixed"]),

@@ -54,7 +54,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rotorub_model.results import pyplot, save_figure, write_json
+from rotorub_model.plotting import pyplot, save_figure
+from rotorub_model.writing import write_json
 
 from ..masters.fmi2 import FMUError, Slave
 from ..models.contact.builder import build_native_fmu
@@ -228,11 +229,12 @@ class CoupledResult:
             meta = json.loads(str(d["meta"]))
         return cls(meta=meta, **arrays)
 
-    def plot(self, path: str | Path, reference: CoupledResult | None = None) -> Path:
-        """PNG: spin speed (with the rub-free run), speed shortfall, friction torque, contact forces."""
+    def figure(self, reference: CoupledResult | None = None):
+        """Spin speed (with the rub-free run), speed shortfall, friction torque, contact forces per blade (each
+        blade in its colour, named in the legend beside the panel, with the largest over the blades)."""
+        from rotorub_model.plotting import legend_outside, plot_blade_forces
+
         plt = pyplot()
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
         fig, ax = plt.subplots(4, 1, figsize=(9, 11), sharex=True)
         t = self.t
         if reference is not None:
@@ -256,14 +258,24 @@ class CoupledResult:
         ax[2].plot(t, self.friction_torque, "C0", lw=0.8)
         ax[2].set_ylabel("friction torque [N m]")
         if self.F_N.size:
-            ax[3].plot(t, self.F_N, lw=0.5, alpha=0.6)
-            ax[3].plot(t, self.F_N.max(axis=1), "k", lw=0.8, label="max over blades")
-            ax[3].legend(loc="upper left", fontsize=8)
+            plot_blade_forces(ax[3], t, self.F_N, lw=0.7)
+            ax[3].plot(t, self.F_N.max(axis=1), "k", lw=0.8, ls=":", label="largest over the blades")
+            legend_outside(ax[3])
         ax[3].set_ylabel("normal contact force per blade [N]")
         ax[3].set_xlabel("time [s]")
         for a in ax:
             a.grid(alpha=0.3)
-        return save_figure(fig, path, dpi=110)
+        return fig
+
+    def save(self, out: str | Path, reference: CoupledResult | None = None, stem: str = "coupled_runup") -> dict:
+        """``<stem>.png``, ``<stem>.json`` (the summary against ``reference``) and ``<stem>.npz`` in ``out``."""
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        save_figure(self.figure(reference), out / f"{stem}.png", dpi=110)
+        self.save_npz(out / f"{stem}.npz")
+        s = self.summary(reference)
+        write_json(out / f"{stem}.json", s)
+        return s
 
 
 def run_coupled(contact_fmu: str | Path, spool_fmu: str | Path, t_end: float, h: float = 1e-3,
@@ -418,18 +430,20 @@ def scenario_settings(quick: bool = True) -> dict:
 
 def run_coupled_scenario(out_dir: str | Path, quick: bool = True, contact_fmu: str | Path | None = None,
                          spool_fmu: str | Path | None = None, progress: bool = False,
-                         fmu_dir: str | Path | None = None) -> dict:
+                         fmu_dir: str | Path | None = None, platforms: tuple[str, ...] | None = None) -> dict:
     """Build the FMUs (unless given: the native contact and spool FMUs, no Python on a host), write and
     validate the SSP, run the rub-free and the rub cases in the fmpy master loop, the rub case's SSP in libcosim
     and in the C master (no Python in the process), and save ``no_rub.npz``, ``rub.npz``, ``coupled_runup.png``,
-    ``summary.json`` in ``out_dir``."""
+    ``summary.json`` in ``out_dir``. ``platforms``: the binaries of the FMUs it builds (None: every platform;
+    the main job: this machine's, the one it runs)."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     cfg = scenario_settings(quick)
     t0 = time.perf_counter()
     fmu_dir = Path(fmu_dir) if fmu_dir else out / "fmus"
-    contact_fmu = Path(contact_fmu) if contact_fmu else Path(build_native_fmu(fmu_dir / "native")["fmu"])
-    spool_fmu = Path(spool_fmu) if spool_fmu else build_native_spool_fmu(fmu_dir / "native")
+    contact_fmu = Path(contact_fmu) if contact_fmu else Path(build_native_fmu(fmu_dir / "native",
+                                                                              platforms=platforms)["fmu"])
+    spool_fmu = Path(spool_fmu) if spool_fmu else build_native_spool_fmu(fmu_dir / "native", platforms=platforms)
     build_s = time.perf_counter() - t0
     ssp = write_ssp(out / "RotorRubEngine.ssp", contact_fmu, spool_fmu, g0=cfg["g0_rub"], imbalance=cfg["imbalance"],
                     formulation=cfg["formulation"], spool_params=cfg["spool_params"], t_end=cfg["t_end"], h=cfg["h"])
@@ -442,7 +456,7 @@ def run_coupled_scenario(out_dir: str | Path, quick: bool = True, contact_fmu: s
     rub = run_coupled(contact_fmu, spool_fmu, g0=cfg["g0_rub"], **common)
     ref.save_npz(out / "no_rub.npz")
     rub.save_npz(out / "rub.npz")
-    rub.plot(out / "coupled_runup.png", reference=ref)
+    save_figure(rub.figure(reference=ref), out / "coupled_runup.png", dpi=110)
     summary = rub.summary(reference=ref)
     summary.update({"no_rub_max_deviation_from_schedule_rad_s": float(np.max(np.abs(ref.omega - ref.omega_schedule))),
                     "no_rub_max_friction_torque_N_m": float(np.max(np.abs(ref.friction_torque))),

@@ -30,7 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rotorub_model.results import pyplot, save_figure, write_json
+from rotorub_model.plotting import pyplot, save_figure
+from rotorub_model.writing import write_json
 
 from ..fmi.description import read_description
 from ..models.casing_load import crosscheck as casing_closed_form

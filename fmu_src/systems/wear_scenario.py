@@ -24,7 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rotorub_model.results import pyplot, save_figure, write_json
+from rotorub_model.plotting import pyplot, save_figure
+from rotorub_model.writing import write_json
 
 from ..models.clearance.builder import build_clearance_fmu
 from ..models.contact.builder import build_native_fmu
@@ -60,14 +61,17 @@ def build_wear_fmus(fmu_dir: str | Path, platforms: tuple[str, ...] | None = Non
 
 
 def run_wear_scenario(out_dir: str | Path, quick: bool = True, fmu_dir: str | Path | None = None,
-                      fmus: dict[str, Path] | None = None, imbalance: float = IMBALANCE) -> dict:
-    """Build the FMUs (unless given), write and validate the package, run it in fmpy, libcosim and the C master,
-    save ``wear_engine.npz``, ``wear_engine.png`` and ``summary.json`` in ``out_dir``; returns the summary."""
+                      fmus: dict[str, Path] | None = None, imbalance: float = IMBALANCE,
+                      platforms: tuple[str, ...] | None = None) -> dict:
+    """Build the FMUs (unless given; ``platforms``: their binaries, None for every platform), write and validate the
+    package, run it in fmpy, libcosim and the C master, save ``wear_engine.npz``, ``wear_engine.png`` and
+    ``summary.json`` in ``out_dir``; returns the summary."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     cfg = scenario_settings(quick)
     t0 = time.perf_counter()
-    fmus = fmus or build_wear_fmus(Path(fmu_dir) if fmu_dir else out / "fmus", omega0=cfg["spool_params"]["Omega0"])
+    fmus = fmus or build_wear_fmus(Path(fmu_dir) if fmu_dir else out / "fmus", platforms=platforms,
+                                   omega0=cfg["spool_params"]["Omega0"])
     build_s = time.perf_counter() - t0
     common = {"g0": G0_RUB, "imbalance": imbalance, "formulation": cfg["formulation"],
               "spool_params": cfg["spool_params"], "t_end": cfg["t_end"], "h": cfg["h"]}

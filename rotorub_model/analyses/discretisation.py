@@ -24,9 +24,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..results import pyplot, save_figure, save_result
+from ..plotting import pyplot
 from ..structure.blades import bladed_disk_matrices
 from ..structure.params import Parameters
+from ..writing import save_result
 
 N_CONVERGED = 8  # functions of the converged reference (flap and lag agree with 10 to 1e-5)
 
@@ -149,10 +150,10 @@ class BladeConvergence:
         rows.append(f"| {N_CONVERGED} (converged) | {N_CONVERGED} | {N_CONVERGED} | 0 | 0 | {ref_top:.0f} Hz |")
         return "\n".join(rows)
 
-    def plot(self, path: str | Path) -> Path:
+    def figure(self):
         """Error against n: one colour per number of functions in both panels (flap solid, lag dashed; the
         reduced bases in their n_ritz's colour, a line style and marker per n_modes), legends outside."""
-        from ..results import legend_outside
+        from ..plotting import legend_outside
 
         plt = pyplot()
         fig, axes = plt.subplots(1, 2, figsize=(12, 4.4))
@@ -187,7 +188,7 @@ class BladeConvergence:
         for ax in axes:
             ax.grid(alpha=0.3, which="both")
             legend_outside(ax)
-        return save_figure(fig, path)
+        return fig
 
     def save(self, out: str | Path) -> dict:
         s = save_result(self, out, "blade_convergence")

@@ -21,6 +21,7 @@ P_drive); the tests hold E - W_drive to the integrator's own O(dt^2) oscillation
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -52,6 +53,52 @@ class EnergyHistory:
     def balance(self) -> np.ndarray:
         """E - W_drive: never rises (beyond the integrator's oscillation) if the model creates no energy."""
         return self.energy - self.drive_work
+
+    def largest_rise(self) -> float:
+        """The largest rise of E - W_drive over any earlier value [J] (0 when it never rises)."""
+        b = self.balance
+        return float(np.max(b - np.minimum.accumulate(b))) if b.size else 0.0
+
+    def summary(self) -> dict:
+        b = self.balance
+        scale = float(np.max(np.abs(self.energy))) if self.energy.size else 0.0
+        rise = self.largest_rise()
+        return {"t_s": [float(self.t[0]), float(self.t[-1])] if self.t.size else None,
+                "energy_start_J": float(self.energy[0]) if b.size else None,
+                "energy_end_J": float(self.energy[-1]) if b.size else None,
+                "drive_work_J": float(self.drive_work[-1]) if b.size else None,
+                "dissipated_J": float(b[0] - b[-1]) if b.size else None,
+                "largest_rise_of_balance_J": rise, "largest_rise_relative": rise / scale if scale > 0 else 0.0,
+                "verdict": self.verdict()}
+
+    def verdict(self) -> str:
+        scale = float(np.max(np.abs(self.energy))) if self.energy.size else 0.0
+        rise = self.largest_rise()
+        return (f"E - W_drive never rises by more than {rise:.3g} J ({rise / scale:.2g} of the largest energy): "
+                "no energy created" if scale > 0 else "no motion")
+
+    def figure(self):
+        """E, the drive's work and their difference (which friction can only lower), the verdict in the title."""
+        from ..plotting import pyplot
+
+        fig, axes = pyplot().subplots(2, 1, figsize=(8, 5.5), sharex=True, layout="constrained")
+        axes[0].plot(self.t, self.energy, lw=1, label="E: kinetic + strain + contact potential")
+        axes[0].plot(self.t, self.drive_work, lw=1, label="W_drive: work the drive fed in")
+        axes[0].set_ylabel("energy [J]")
+        axes[0].legend(fontsize=8)
+        axes[1].plot(self.t, self.balance, lw=1, color="k", label="E − W_drive (friction lowers it)")
+        axes[1].set_ylabel("E − W_drive [J]")
+        axes[1].set_xlabel("time [s]")
+        axes[1].legend(fontsize=8)
+        for ax in axes:
+            ax.grid(alpha=0.3)
+        fig.suptitle(f"Energy balance: {self.verdict()}", fontsize=9)
+        return fig
+
+    def save(self, out: str | Path, stem: str = "energy") -> dict:
+        from ..writing import save_result
+
+        return save_result(self, out, stem)
 
 
 def energy_history(model: Model, contact: ContactModel, q: np.ndarray, dt: float, omega: float) -> EnergyHistory:

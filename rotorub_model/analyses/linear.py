@@ -29,8 +29,9 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
-from ..results import pyplot, save_figure, save_result
+from ..plotting import pyplot
 from ..structure.model import Model
+from ..writing import save_result
 
 
 def linear_response(model: Model, omega: float, me: float | None = None) -> np.ndarray:
@@ -85,7 +86,8 @@ class ResponseResult:
             "warning": self.warning,
         }
 
-    def plot(self, path: str | Path) -> Path:
+    def figure(self):
+        """The fan disk's response over the speed range, the critical speeds marked."""
         plt = pyplot()
         fig, ax = plt.subplots(figsize=(7, 4))
         if self.amplitude.any():
@@ -93,6 +95,7 @@ class ResponseResult:
             for c, a in zip(self.critical_speeds, self.peak_amplitudes):
                 ax.plot(c, a * 1e3, "o", color="C3")
                 ax.annotate(f"Ω={c:.2f}", (c, a * 1e3), textcoords="offset points", xytext=(5, 5))
+            ax.set_ylim(top=4.0 * float(self.amplitude.max()) * 1e3)  # room for the peaks' labels
         else:  # no imbalance (imbalance.me = 0): no response, the critical speeds still are where they are
             ax.plot(self.speeds, self.amplitude * 1e3, lw=1.2)
             for c in self.critical_speeds:
@@ -100,10 +103,13 @@ class ResponseResult:
                 ax.annotate(f"critical Ω={c:.2f}", (c, 0.0), textcoords="offset points", xytext=(5, 5))
         ax.set_xlabel("normalised spin speed Ω / Ω_ref")
         ax.set_ylabel("fan-disk displacement [mm]")
+        crit = ", ".join(f"{c:.3g}" for c in self.critical_speeds) or "none in the range"
         ax.set_title("Imbalance response at the fan disk" + ("" if self.amplitude.any() else
-                                                               " (no imbalance: imbalance.me = 0)"))
+                                                               " (no imbalance: imbalance.me = 0)")
+                     + f"\ncritical speeds Ω / Ω_ref: {crit}", fontsize=10)
+        ax.set_xlim(float(self.speeds[0]), float(self.speeds[-1]))
         ax.grid(True, which="both", alpha=0.3)
-        return save_figure(fig, path)
+        return fig
 
     def save(self, out: str | Path) -> dict:
         s = save_result(self, out, "response", "summary")
@@ -230,20 +236,38 @@ class ModesResult:
             ],
         }
 
-    def plot(self, path: str | Path) -> Path:
+    def figure(self):
+        """The modes in the fixed frame: frequency an observer sees against the damping ratio (log scale: the modes
+        near Re λ = 0, which overlap on a real-part axis, spread out by frequency), coloured by nodal diameter,
+        each labelled with it; a mode with a negative damping ratio (unstable) drawn red at the bottom."""
+        from matplotlib.colors import BoundaryNorm, ListedColormap
+
         plt = pyplot()
-        fig, ax = plt.subplots(figsize=(7, 4))
+        fig, ax = plt.subplots(figsize=(8, 4.6))
         h = np.abs(self.harmonic)
-        sc = ax.scatter(self.eigenvalues.real, self.eigenvalues.imag / (2 * np.pi), c=h, cmap="viridis",
-                        vmin=0, vmax=max(int(h.max()), 1))
-        cb = fig.colorbar(sc, ax=ax)
-        cb.set_label("|nodal diameter index|")
-        ax.axvline(0, color="k", lw=0.8)
-        ax.set_xlabel("real part [1/s]")
-        ax.set_ylabel("rotating-frame frequency [Hz]")
-        ax.set_title(f"Eigenvalues at Ω = {self.speed:.3g} Ω_ref")
-        ax.grid(alpha=0.3)
-        return save_figure(fig, path)
+        top = max(int(h.max()), 1)
+        cmap = ListedColormap(plt.get_cmap("tab10" if top < 10 else "tab20")(np.arange(top + 1)))
+        norm = BoundaryNorm(np.arange(-0.5, top + 1.0), top + 1)
+        z = np.asarray(self.damping_ratio, dtype=float)
+        stable = z > 0
+        floor = max(float(z[stable].min()) * 0.5, 1e-6) if stable.any() else 1e-4
+        y = np.where(stable, z, floor)
+        sc = ax.scatter(self.fixed_frame_hz, y, c=h, cmap=cmap, norm=norm, s=30, zorder=3,
+                        edgecolors=np.where(stable, "none", "red"), linewidths=1.2)
+        for f, yy, nd in zip(self.fixed_frame_hz, y, self.harmonic):
+            ax.annotate(f"{int(nd):+d}" if nd else "0", (f, yy), textcoords="offset points", xytext=(3, 3),
+                        fontsize=6.5, color="0.3")
+        ax.set_yscale("log")
+        cb = fig.colorbar(sc, ax=ax, ticks=range(top + 1))
+        cb.set_label("|nodal diameter index| (the sign: + forward, − backward)")
+        ax.set_xlabel("fixed-frame frequency [Hz] (what an observer on the casing sees)")
+        ax.set_ylabel("damping ratio ζ (fixed frame) [-]")
+        n_unstable = int((~stable).sum())
+        ax.set_title(f"Modes at Ω = {self.speed:.3g} Ω_ref, fixed frame: {len(z)} modes, "
+                     + (f"{n_unstable} unstable (red, drawn at the bottom)" if n_unstable else "all damped"),
+                     fontsize=10)
+        ax.grid(alpha=0.3, which="both")
+        return fig
 
     def save(self, out: str | Path) -> dict:
         return save_result(self, out, "modes")
@@ -374,9 +398,14 @@ class CampbellResult:
             "nodal_diameter_index": self.harmonic,
         }
 
-    def plot(self, path: str | Path, fmax_hz: float | None = None) -> Path:
+    def figure(self, fmax_hz: float | None = None):
+        """Every mode's fixed-frame frequency at every speed as a dot coloured by its nodal diameter (a branch of
+        nodal diameter m climbs or falls m Ω per unit of rotating-frame frequency: the steep ones are high nodal
+        diameters, their dots a speed step apart), the 1X line; up to 1.3 x the top speed's 1X."""
+        from matplotlib.lines import Line2D
+
         plt = pyplot()
-        fig, ax = plt.subplots(figsize=(7, 5))
+        fig, ax = plt.subplots(figsize=(7, 5.6), layout="constrained")
         nd = np.abs(self.harmonic)
         top = max(int(nd.max()), 1)
         # one colour per nodal diameter (a discrete scale: colour means the index, not a shade of it)
@@ -392,9 +421,13 @@ class CampbellResult:
         ax.set_ylabel("fixed-frame frequency [Hz]")
         ax.set_title(f"Campbell diagram ({len(self.speeds)} speeds)")
         fig.colorbar(sc, ax=ax, label="|nodal diameter index|", ticks=range(top + 1))
-        ax.legend(loc="upper left")
+        dot = Line2D([], [], ls="none", marker="o", ms=3, color="0.4",
+                     label="one mode at one speed, coloured by its nodal diameter (the steep branches, high nodal "
+                           "diameters,\nclimb m Ω per speed step and so read as dotted lines)")
+        h, _ = ax.get_legend_handles_labels()
+        fig.legend(handles=[*h, dot], loc="outside lower center", fontsize=7.5, frameon=False)
         ax.grid(alpha=0.3)
-        return save_figure(fig, path)
+        return fig
 
     def save(self, out: str | Path) -> dict:
         return save_result(self, out, "campbell")

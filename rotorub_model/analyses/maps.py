@@ -39,9 +39,10 @@ from pathlib import Path
 import numpy as np
 
 from ..contact import ContactModel, make_contact
-from ..results import pyplot, save_figure, save_result
+from ..plotting import pyplot
 from ..structure.model import Model, build_model
 from ..structure.params import from_dict, to_dict
+from ..writing import save_result
 from .stability import stability_indicators
 from .static import StaticResult, solve_static
 from .sweeps import run_tasks
@@ -296,18 +297,10 @@ class StabilityMap:
             "max_sum_positive_real": float(np.nanmax(self.sum_pos)) if np.isfinite(self.sum_pos).any() else 0.0,
         }
 
-    def plot(self, path: str | Path) -> Path:
-        plt = pyplot()
-        fig, axes = plt.subplots(1, 2, figsize=(11, 4.8), sharey=True)
-        draw_contact_panel(fig, axes[0], self)
-        draw_stability_panel(fig, axes[1], self)
-        axes[0].set_ylabel("initial clearance g0 [mm]")
-        axes[0].set_title(f"{self.formulation}: blades in contact")
-        axes[1].set_title(f"{self.formulation}: stability of the static solution")
-        h = category_handles([self])
-        fig.legend(handles=h, loc="lower center", ncol=len(h), fontsize=8, frameon=False, bbox_to_anchor=(0.5, 0.0))
-        fig.tight_layout(rect=(0, 0.07, 1, 1))
-        return save_figure(fig, path, layout=False)
+    def figure(self):
+        """Blades in contact (left) and the stability of the static solution (right), the flat colours' legend
+        below, the clearance axis where the contact region is."""
+        return maps_figure({self.formulation: self})
 
     @classmethod
     def load(cls, folder: str | Path, formulation: str) -> StabilityMap:
@@ -318,6 +311,7 @@ class StabilityMap:
                    d["sum_pos"], d["converged"], rescued)
 
     def save(self, out: str | Path) -> dict:
+        """stability_<formulation>.png, .json and .npz in ``out``; returns the summary."""
         stem = f"stability_{self.formulation}"
         s = save_result(self, out, stem)
         extra = {} if self.from_contact_set is None else {"from_contact_set": self.from_contact_set}
@@ -390,31 +384,95 @@ def _finish(ax, m: StabilityMap) -> None:
     ax.grid(alpha=0.2)
 
 
-def draw_contact_panel(fig, ax, m: StabilityMap, cax=None) -> None:
-    """Blades in contact: one colour per count (a discrete scale, its colourbar ticked per count)."""
+def contact_norm(maps: list[StabilityMap]):
+    """One discrete scale of blade counts for every panel of a figure (colour means the count in all of them)."""
     from matplotlib.colors import BoundaryNorm, ListedColormap
 
-    nmax = max(int(m.n_contact.max()), 1)
+    nmax = max(max(int(m.n_contact.max()) for m in maps), 1)
     cmap = ListedColormap(pyplot().get_cmap("viridis")(np.linspace(0.0, 1.0, nmax)))
-    norm = BoundaryNorm(np.arange(0.5, nmax + 1.0), nmax)
-    im = ax.pcolormesh(m.speeds, m.g0s * 1e3, np.where(m.contact, m.n_contact, np.nan).T, cmap=cmap, norm=norm,
-                       shading="nearest")
-    fig.colorbar(im, ax=ax, cax=cax, label="blades in contact [-]", ticks=range(1, nmax + 1))
-    _finish(ax, m)
+    return cmap, BoundaryNorm(np.arange(0.5, nmax + 1.0), nmax), nmax
 
 
-def draw_stability_panel(fig, ax, m: StabilityMap, cax=None) -> None:
-    """Stable contact cells flat blue; unstable ones coloured by the sum of positive real parts (log scale)."""
+def unstable_norm(maps: list[StabilityMap]):
+    """One logarithmic scale of the sum of positive real parts for every panel (the same colour, the same rate)."""
     from matplotlib.colors import LogNorm
 
+    vals = [m.sum_pos[m.contact & m.unstable] for m in maps]
+    pos = np.concatenate([v[np.isfinite(v) & (v > 0)] for v in vals]) if vals else np.zeros(0)
+    lo, hi = (float(pos.min()), float(pos.max())) if pos.size else (1e-6, 1.0)
+    return LogNorm(vmin=lo, vmax=max(hi, lo * 10))
+
+
+def draw_contact_panel(fig, ax, m: StabilityMap, cax=None, scale=None, colourbar: bool = True):
+    """Blades in contact: one colour per count (a discrete scale, its colourbar ticked per count); ``scale``: the
+    figure's shared (cmap, norm, nmax) of :func:`contact_norm`. Returns the mesh (for a shared colourbar)."""
+    cmap, norm, nmax = scale or contact_norm([m])
+    im = ax.pcolormesh(m.speeds, m.g0s * 1e3, np.where(m.contact, m.n_contact, np.nan).T, cmap=cmap, norm=norm,
+                       shading="nearest")
+    if colourbar:
+        fig.colorbar(im, ax=ax, cax=cax, label="blades in contact [-]", ticks=range(1, nmax + 1))
+    _finish(ax, m)
+    return im
+
+
+def draw_stability_panel(fig, ax, m: StabilityMap, cax=None, norm=None, colourbar: bool = True):
+    """Stable contact cells flat blue; unstable ones coloured by the sum of positive real parts (log scale;
+    ``norm``: the figure's shared :func:`unstable_norm`). Returns the mesh (for a shared colourbar)."""
     _cells(ax, m, m.contact & ~m.unstable, STABLE_COLOUR, 1)
     val = np.where(m.contact & m.unstable, m.sum_pos, np.nan)
-    pos = val[np.isfinite(val) & (val > 0)]
-    lo, hi = (float(pos.min()), float(pos.max())) if pos.size else (1e-6, 1.0)
     im = ax.pcolormesh(m.speeds, m.g0s * 1e3, val.T, cmap=unstable_cmap(), shading="nearest", zorder=2,
-                       norm=LogNorm(vmin=lo, vmax=max(hi, lo * 10)))
-    fig.colorbar(im, ax=ax, cax=cax, label="unstable: Σ Re(λ) > 0 [1/s]")
+                       norm=norm or unstable_norm([m]))
+    if colourbar:
+        fig.colorbar(im, ax=ax, cax=cax, label="unstable: Σ Re(λ) > 0 [1/s]")
     _finish(ax, m)
+    return im
+
+
+def contact_top_mm(maps: list[StabilityMap]) -> float | None:
+    """Where a map's clearance axis ends: a cell and a quarter above the highest clearance with anything but 'no
+    contact' at any speed of any map (None: no such cell). The grid runs to 1.6 x the peak response, the contact
+    region at most to the 3D closure: the rest would be blank axis."""
+    tops = []
+    for m in maps:
+        j = np.flatnonzero((m.n_contact != 0).any(axis=0))
+        if j.size:
+            j = int(j.max())
+            g = m.g0s * 1e3
+            step = (g[j + 1] - g[j]) if j + 1 < len(g) else (g[j] - g[j - 1] if j else 1.0)
+            tops.append(float(g[j] + 1.25 * step))
+    return max(tops) if tops else None
+
+
+def maps_figure(maps: dict[str, StabilityMap]):
+    """Rows of maps (2D over 3D), blades in contact left and stability right, one colour scale per column shared by
+    its rows (the same colour is the same count, the same rate), the flat colours' legend below, the clearance axis
+    ending above the contact region (the grid's top named in the title when it is cut)."""
+    plt = pyplot()
+    ms = list(maps.values())
+    n = len(ms)
+    fig, axes = plt.subplots(n, 2, figsize=(11, 1.0 + 3.9 * n), sharex=True, sharey=True, squeeze=False,
+                             layout="constrained")
+    scale, norm = contact_norm(ms), unstable_norm(ms)
+    for row, (f, m) in enumerate(maps.items()):
+        ic = draw_contact_panel(fig, axes[row, 0], m, scale=scale, colourbar=False)
+        iu = draw_stability_panel(fig, axes[row, 1], m, norm=norm, colourbar=False)
+        axes[row, 0].set_ylabel(f"{f}: initial clearance g0 [mm]")
+        for ax in axes[row]:
+            ax.set_xlabel("normalised spin speed Ω / Ω_ref [-]" if row == n - 1 else "")
+    fig.colorbar(ic, ax=list(axes[:, 0]), label="blades in contact [-]", ticks=range(1, scale[2] + 1))
+    fig.colorbar(iu, ax=list(axes[:, 1]), label="unstable: Σ Re(λ) > 0 [1/s]" + (" (one scale, both rows)" if n > 1
+                                                                                  else ""))
+    axes[0, 0].set_title("blades in contact")
+    axes[0, 1].set_title("stability of the static solution")
+    top = contact_top_mm(ms)
+    grid_top = max(float(m.g0s[-1]) * 1e3 for m in ms)
+    if top is not None and top < grid_top:
+        axes[0, 0].set_ylim(min(float(m.g0s[0]) for m in ms) * 1e3, top)
+        fig.suptitle(f"clearance axis cut at {top:.3g} mm: no contact above, up to the grid's {grid_top:.3g} mm",
+                     fontsize=8.5)
+    h = category_handles(ms)
+    fig.legend(handles=h, loc="outside lower center", ncol=min(len(h), 3), fontsize=8.5, frameon=False)
+    return fig
 
 
 def category_handles(maps: list[StabilityMap]) -> list:

@@ -12,6 +12,7 @@ the unstable modes with their rotating-frame frequency and dominant dofs.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -39,8 +40,54 @@ class StabilityResult:
             "max_real_part": self.max_real,
             "sum_positive_real_parts": self.sum_positive_real,
             "stable": self.stable,
+            "verdict": self.verdict(),
             "unstable_modes": self.unstable_modes,
         }
+
+    def verdict(self) -> str:
+        if self.stable:
+            return f"stable: every Re λ ≤ {RE_TOL:g} 1/s (largest {self.max_real:+.3g} 1/s)"
+        n = len(self.unstable_modes)
+        return (f"unstable: {n} mode{'s' if n != 1 else ''} with Re λ > 0, largest {self.max_real:+.3g} 1/s, "
+                f"sum {self.sum_positive_real:.3g} 1/s")
+
+    def draw(self, ax) -> None:
+        """The eigenvalues on ``ax``: rotating-frame frequency against the real part on a symmetric log axis (the
+        least damped, near Re λ = 0, spread out; its linear band ±1e-3 1/s marked), the unstable ones red."""
+        lam = np.asarray(self.eigenvalues)
+        bad = lam.real > RE_TOL
+        ax.scatter(lam.real[~bad], np.abs(lam.imag[~bad]) / (2 * np.pi), s=14, color="C0", label="Re λ ≤ 0 (damped)")
+        if bad.any():
+            ax.scatter(lam.real[bad], np.abs(lam.imag[bad]) / (2 * np.pi), s=30, color="C3", marker="D",
+                       label="Re λ > 0 (unstable)")
+        ax.set_xscale("symlog", linthresh=1e-3)
+        # every other decade, labelled at an angle (a symlog axis labels every decade, and they overlap)
+        lo, hi = float(lam.real.min()), float(lam.real.max())
+        neg = [-(10.0 ** k) for k in range(int(np.ceil(np.log10(-lo))), -4, -2)] if lo < -1e-3 else []
+        pos = [10.0 ** k for k in range(-3, int(np.ceil(np.log10(hi))) + 1, 2)] if hi > 1e-3 else []
+        ticks = [*neg, 0.0, *pos]
+        ax.set_xticks(ticks, [("0" if t == 0 else f"{t:.0e}".replace("e+0", "e").replace("e-0", "e-")) for t in ticks],
+                      rotation=40, fontsize=7.5)
+        ax.axvspan(-1e-3, 1e-3, color="0.92", zorder=0, label="linear axis within ±1e-3 1/s")
+        ax.axvline(0, color="k", lw=0.8)
+        ax.set_xlabel("real part Re λ [1/s] (symmetric log axis)")
+        ax.set_ylabel("rotating-frame frequency [Hz]")
+        ax.set_title(self.verdict(), fontsize=8)
+        ax.legend(fontsize=7, loc="upper left")
+        ax.grid(alpha=0.3)
+
+    def figure(self):
+        from ..plotting import pyplot
+
+        fig, ax = pyplot().subplots(figsize=(6.5, 4), layout="constrained")
+        self.draw(ax)
+        return fig
+
+    def save(self, out: str | Path, stem: str = "stability") -> dict:
+        """``<stem>.png`` and ``<stem>.json`` in ``out``; returns the summary."""
+        from ..writing import save_result
+
+        return save_result(self, out, stem)
 
 
 def stability_indicators(model: Model, contact: ContactModel, omega: float, q0: np.ndarray) -> tuple[float, float]:

@@ -23,6 +23,9 @@ FIGURES = [
     ("Stability boundary by continuation over the grid maps", "continuation/boundaries.png"),
     ("Blades' Ritz discretisation: frequency error against the number of functions",
      "discretisation/blade_convergence.png"),
+    ("Will it rub? The rub probability against the build clearance (quick study)",
+     "uq/tolerances/uq_rub_vs_clearance.png"),
+    ("Mistuned disks: contact against linear amplification (quick study)", "uq/mistuning/uq_mistuning.png"),
 ]
 
 
@@ -270,13 +273,27 @@ def write_report(out: str | Path, summary: dict, sections: tuple[str, ...] | lis
     if not failing:
         lines.append("Every fact holds on this configuration.")
     for f in failing:
-        lines.append(f"* Fact {f['id']}: {f.get('why', 'see the values in the table and docs/THEORY.md')}")
+        failed = [c for c in f.get("conditions", []) if not c["holds"]]
+        if not failed:
+            lines.append(f"* Fact {f['id']}: {f.get('why', 'see the values in the table and docs/THEORY.md')}")
+            continue
+        lines.append(f"* Fact {f['id']}: {len(failed)} of its {len(f['conditions'])} conditions "
+                     + ("fails:" if len(failed) == 1 else "fail:"))
+        for c in failed:
+            whose = (" — a number of the paper's rotor: another configuration need not have it, not a defect of this "
+                     "one" if c["kind"] == "the paper's rotor" else " — the paper's finding does not hold here")
+            lines.append(f"  * {c['condition']}: ours {c['ours']}{whose}")
+        if f.get("note"):  # a fact's further explanation, where it has one
+            lines.append(f"  * {f['note']}")
     if "wear" in summary:
         lines += _wear_section(summary["wear"])
     if "continuation" in summary:
         lines += _continuation_section(summary["continuation"])
     if "blade_discretisation" in summary:
         lines += _discretisation_section(summary["blade_discretisation"])
+    for rel in summary.get("report_sections", []):  # sections the library's quick studies wrote next to their files
+        if (out / rel).is_file():
+            lines += ["", *(out / rel).read_text().rstrip("\n").split("\n")]
     for section in sections:
         lines += section.rstrip("\n").split("\n")
     lines += ["", "## Figures", ""]

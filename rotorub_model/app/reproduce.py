@@ -11,28 +11,39 @@ import hashlib
 import json
 from pathlib import Path
 
-from ..results import write_json
+from ..facts import FINDING, ROTOR, condition, with_conditions  # noqa: F401
 from ..structure.model import Model
+from ..writing import write_json
 
 
 def fact1(resp: dict) -> dict:
     c = resp["critical_speeds"]
     a = resp["peak_amplitudes_m"]
-    holds = len(c) == 2 and abs(c[0] - 3.5) <= 0.2 and abs(c[1] - 8.0) <= 0.5 and a[0] >= 5 * a[1]
-    return {
+    ratio = a[0] / a[1] if len(a) > 1 and a[1] > 0 else None
+    f = {
         "id": 1,
         "statement": "two critical speeds in 0 < Omega <= 10, near 3.5 and 8, first peak > 5x the second",
         "paper": {"critical_speeds": [3.5, 8.0], "peak_ratio_min": 5.0},
-        "ours": {"critical_speeds": c, "peak_ratio": a[0] / a[1] if len(a) > 1 else None},
-        "holds": bool(holds),
+        "ours": {"critical_speeds": c, "peak_ratio": ratio},
     }
+    speeds = ", ".join(f"{x:.3g}" for x in c) or "none"
+    return with_conditions(f, [
+        condition("two critical speeds in (0, 10]", len(c) == 2, f"{len(c)} ({speeds})", ROTOR),
+        condition("the first within 0.2 of 3.5", len(c) >= 1 and abs(c[0] - 3.5) <= 0.2,
+                  f"{c[0]:.3g}" if c else "none", ROTOR),
+        condition("the second within 0.5 of 8", len(c) >= 2 and abs(c[1] - 8.0) <= 0.5,
+                  f"{c[1]:.3g}" if len(c) > 1 else "none", ROTOR),
+        condition("the first peak at least 5 x the second", ratio is not None and ratio >= 5.0,
+                  "–" if ratio is None else f"{ratio:.3g} x", ROTOR),
+    ])
 
 
 def fact5(stab: dict) -> dict:
     from ..analyses.maps import STABLE_STRIP_MIN
 
     u2, u3 = stab["unstable_fraction_2d"], stab["unstable_fraction_3d"]
-    b3 = stab["map_3d"]["boundary_stable_fraction"]
+    m3 = stab["map_3d"]
+    b3 = m3["boundary_stable_fraction"]
     f = {
         "id": 5,
         "statement": "static solutions: 2D unstable over almost the whole contact area; 3D a smaller unstable "
@@ -40,31 +51,23 @@ def fact5(stab: dict) -> dict:
         "paper": {"unstable_fraction_2d": "almost all", "unstable_fraction_3d": "smaller", "stable_strip_3d": True},
         "ours": {"unstable_fraction_2d": u2, "unstable_fraction_3d": u3, "stable_strip_3d": stab["stable_strip_3d"],
                  "boundary_stable_fraction_3d": b3,
-                 "boundary_stable_cells_3d": stab["map_3d"].get("boundary_stable_cells"),
-                 "boundary_cells_3d": stab["map_3d"].get("boundary_cells"),
+                 "boundary_stable_cells_3d": m3.get("boundary_stable_cells"),
+                 "boundary_cells_3d": m3.get("boundary_cells"),
                  "max_blades_in_contact": [stab["max_blades_in_contact_2d"], stab["max_blades_in_contact_3d"]]},
-        "holds": bool(u2 >= 0.8 and u3 < u2 and stab["stable_strip_3d"]),
     }
-    if not f["holds"]:
-        why = []
-        if u2 < 0.8:
-            why.append(f"the 2D solutions are unstable over {u2:.0%} of the contact area (almost all: >= 80 %)")
-        if u3 >= u2:
-            why.append(f"the 3D unstable fraction ({u3:.0%}) is not below the 2D one ({u2:.0%})")
-        if not stab["stable_strip_3d"]:
-            m3 = stab["map_3d"]
-            if b3 is None:
-                why.append("the 3D map has no contact region with a free neighbour: no boundary to be stable")
-            else:
-                why.append(f"{b3:.1%} of the 3D contact region's boundary is stable, by area ("
-                           f"{m3.get('boundary_stable_cells', '?')} of its {m3.get('boundary_cells', '?')} boundary "
-                           f"cells); a stable strip needs {STABLE_STRIP_MIN:.0%} (stability/stability_maps.png shows "
-                           "where the boundary is unstable)")
-        f["why"] = "; ".join(why)
-    return f
+    strip = ("no contact region with a free neighbour: no boundary to be stable" if b3 is None else
+             f"{b3:.1%} of the 3D contact region's boundary stable, by area ({m3.get('boundary_stable_cells', '?')} of "
+             f"its {m3.get('boundary_cells', '?')} boundary cells; stability/stability_maps.png shows where)")
+    return with_conditions(f, [
+        condition("2D unstable over almost all the contact area (>= 80 %)", u2 >= 0.8, f"{u2:.0%}"),
+        condition("3D unstable over a smaller fraction than 2D", u3 < u2, f"{u3:.0%} against {u2:.0%}"),
+        condition(f"a stable strip around the 3D unstable area (>= {STABLE_STRIP_MIN:.0%} of its boundary stable)",
+                  stab["stable_strip_3d"], strip),
+    ])
 
 
 def fact6(tr: dict) -> list[dict]:
+    pf = tr["partial_chord_fraction_3d"]
     a = {
         "id": "6a",
         "statement": "transient at a point with unstable 2D / stable 3D static solutions: 2D diverges after the "
@@ -73,29 +76,34 @@ def fact6(tr: dict) -> list[dict]:
         "paper": {"speed": 3.3, "g0_mm": 0.8, "blades_at_1s": 3, "partial_chord_fraction_3d": 0.88},
         "ours": {k: tr[k] for k in ("speed", "g0_mm", "diverged_2d", "settled_3d", "blades_in_contact_2d_at_1s",
                                     "blades_in_contact_3d_at_1s", "partial_chord_fraction_3d")},
-        "holds": bool(tr["diverged_2d"] and tr["settled_3d"] and tr["blades_in_contact_2d_at_1s"] == 3
-                      and tr["blades_in_contact_3d_at_1s"] == 3 and 0 < tr["partial_chord_fraction_3d"] < 1),
     }
+    v2 = (tr.get("verdicts") or {}).get("2D", "")
+    a = with_conditions(a, [
+        condition("the 2D run diverges after the ramp", tr["diverged_2d"] is True,
+                  v2 or ("no verdict" if tr["diverged_2d"] is None else "not diverging")),
+        condition("the 3D run settles on its static solution", tr["settled_3d"],
+                  "settled" if tr["settled_3d"] else "not settled"),
+        condition("three blades touch at 1 s in 2D", tr["blades_in_contact_2d_at_1s"] == 3,
+                  f"{tr['blades_in_contact_2d_at_1s']}", ROTOR),
+        condition("three blades touch at 1 s in 3D", tr["blades_in_contact_3d_at_1s"] == 3,
+                  f"{tr['blades_in_contact_3d_at_1s']}", ROTOR),
+        condition("the third 3D blade touches only partly along its chord (paper: 88 %)", 0 < pf < 1,
+                  f"{pf:.0%} of its chord", ROTOR),
+    ])
     f = tr["max_force_at_1s_N"]
     b = {
         "id": "6b",
         "statement": "at 1 s the 3D contact force is larger than the 2D one (stability is not set by force amplitude)",
         "paper": {"force_3d_gt_2d": True},
         "ours": {"max_force_at_1s_N": f},
-        "holds": bool(f["3D"] > f["2D"]),
     }
-    if not a["holds"]:
-        from .report import describe_ours
-
-        a["why"] = ("at the chosen point the transients do not show it: " + describe_ours(a) + " (the automatic "
-                    "point choice and the calibration of the casing/contact parameters set this; see docs/THEORY.md "
-                    "section 6)")
+    b = with_conditions(b, [condition("the largest 3D normal force at 1 s above the 2D one", f["3D"] > f["2D"],
+                                      f"{f['3D']:.1f} N (3D) against {f['2D']:.1f} N (2D)")])
     if not b["holds"]:
-        b["why"] = (f"the 3D force at 1 s is {f['3D']:.1f} N against {f['2D']:.1f} N in 2D; the 3D stability "
-                    "at this point comes from the partly touching chord, not from a larger force. Friction "
-                    "against the sliding velocity does not change this: at the fact-6 speed the tips slide at "
-                    "about 1000 times contact.slip_velocity, where the law is the same Coulomb friction as "
-                    "before (docs/THEORY.md section 6)")
+        b["note"] = ("the 3D stability at this point comes from the partly touching chord, not from a larger force. "
+                     "Friction against the sliding velocity does not change this: at the fact-6 speed the tips slide "
+                     "at about 1000 times contact.slip_velocity, where the law is the same Coulomb friction as before "
+                     "(docs/THEORY.md section 6)")
     return [a, b]
 
 
@@ -149,36 +157,66 @@ def run_inputs(model: Model, params_file: str | Path | None, quick: bool, det: d
     }
 
 
-def run_reproduce(model: Model, out: str | Path, quick: bool = False, params_file: str | Path | None = None) -> dict:
+def run_reproduce(model: Model, out: str | Path, quick: bool = False, params_file: str | Path | None = None,
+                  progress: bool = True) -> dict:
     """Every analysis of the paper on ``model``; ``params_file``: the file it was loaded from (recorded with
-    its hash in the summary and the report; None: the embedded reference, or parameters built in memory)."""
+    its hash in the summary and the report; None: the embedded reference, or parameters built in memory).
+    ``progress``: each stage announced on stderr with its time, a heartbeat when one runs long, the loops' bars."""
     from ..analyses.linear import run_campbell, run_modes, run_response
+    from ..progress import stage
 
     out = Path(out)
     sizes = {"response": 600 if quick else 2000, "campbell": 400,
              "discretisation": 13 if quick else 41, "transient_t_end_s": 20.0}
-    resp = run_response(model, n_speeds=sizes["response"]).save(out / "response")
-    run_modes(model, resp["critical_speeds"][0]).save(out / "modes")
-    run_campbell(model, n_speeds=sizes["campbell"]).save(out / "campbell")
+    timings: dict[str, float] = {}
+
+    def step(name: str, what: str):
+        return _timed(stage(what, progress), timings, name)
+
+    with step("linear", "imbalance response, modes at the first critical, Campbell diagram"):
+        resp = run_response(model, n_speeds=sizes["response"]).save(out / "response")
+        run_modes(model, resp["critical_speeds"][0]).save(out / "modes")
+        run_campbell(model, n_speeds=sizes["campbell"]).save(out / "campbell")
     from ..analyses.detection import paper_facts as detection_facts
     from ..analyses.detection import run_detection
 
-    det = run_detection(model, n_speeds=200 if quick else 400).save(out / "detection")
+    with step("detection", "contact detection maps: 2D, 3D, degraded 3D, θ and chord sweeps"):
+        det = run_detection(model, n_speeds=200 if quick else 400, progress=progress).save(out / "detection")
     from ..analyses.discretisation import run_blade_convergence
     from .studies import run_stability_study, run_transient_study
 
-    disc = run_blade_convergence(model.params, n_speeds=sizes["discretisation"])
-    disc_summary = disc.save(out / "discretisation")
-    disc_summary["table_markdown"] = disc.table_markdown()
-    stab = run_stability_study(model, out / "stability", quick=quick)
-    tr = run_transient_study(model, out / "transient", stab_dir=out / "stability", t_end=sizes["transient_t_end_s"])
+    with step("discretisation", "what the blades' Ritz functions cost (frequency errors against n_ritz)"):
+        disc = run_blade_convergence(model.params, n_speeds=sizes["discretisation"])
+        disc_summary = disc.save(out / "discretisation")
+        disc_summary["table_markdown"] = disc.table_markdown()
+    with step("stability", "static and stability maps over (speed, g0), 2D and 3D"):
+        stab = run_stability_study(model, out / "stability", quick=quick, progress=progress)
+    with step("transient", "section 6: 2D and 3D transients at a point with an unstable 2D and a stable 3D "
+                           "static solution"):
+        tr = run_transient_study(model, out / "transient", stab_dir=out / "stability",
+                                 t_end=sizes["transient_t_end_s"], progress=progress)
     from .studies import run_wear_study
 
     # the same rub against an abradable liner (the parameter file's, worn): what it leaves behind
-    wear = run_wear_study(model, out / "wear", tr["speed"], tr["g0_mm"] * 1e-3, t_end=sizes["transient_t_end_s"])
+    with step("wear", "the same rub against the abradable liner, 2D and 3D"):
+        wear = run_wear_study(model, out / "wear", tr["speed"], tr["g0_mm"] * 1e-3, t_end=sizes["transient_t_end_s"],
+                              progress=progress)
     from .studies import run_continuation_study
 
-    cont = run_continuation_study(model, out / "continuation", maps_dir=out / "stability", quick=quick)
+    with step("continuation", "continuation: branches, special points, orbits, boundary curves"):
+        cont = run_continuation_study(model, out / "continuation", maps_dir=out / "stability", quick=quick,
+                                      progress=progress)
+    sections = []
+    with step("forced_response", "forced response of an offset casing (harmonic balance, quick)"):
+        from .forced_response import run_forced_quick
+
+        _, md = run_forced_quick(model, out / "forced_response")
+        sections.append(_section_file(out, "forced_response", md))
+    with step("uncertainty", "will it rub? the quick uncertainty studies (tolerances, mistuning)"):
+        from ..uncertainty.quick import run_uq_quick
+
+        _, md = run_uq_quick(model, out / "uq", progress=progress)
+        sections.append(_section_file(out, "uq", md))
     summary = {
         "inputs": run_inputs(model, params_file, quick, det, stab, sizes),
         "n_dofs": model.n_dofs,
@@ -191,9 +229,66 @@ def run_reproduce(model: Model, out: str | Path, quick: bool = False, params_fil
         "blade_discretisation": disc_summary,
         "continuation": cont,
         "paper_facts": [fact1(resp), *detection_facts(det), fact5(stab), *fact6(tr)],
+        "report_sections": sections,
+        "timings_s": timings,
     }
     write_json(out / "summary.json", summary)
     from .report import write_report
 
     write_report(out, summary)
     return summary
+
+
+def _section_file(out: Path, folder: str, markdown: str) -> str:
+    """A report section another analysis wrote, kept next to its files (the report reads it back by this path;
+    figure links made relative to ``out``)."""
+    import re
+
+    md = re.sub(r"\]\((?!https?:|/)([^)]+)\)", lambda m: f"]({folder}/{m.group(1)})"
+                if not m.group(1).startswith(folder + "/") else m.group(0), markdown)
+    (out / folder).mkdir(parents=True, exist_ok=True)
+    (out / folder / "report_section.md").write_text(md + "\n")
+    return f"{folder}/report_section.md"
+
+
+class _timed:
+    """A stage's context, its wall time kept in ``timings[name]``."""
+
+    def __init__(self, ctx, timings: dict, name: str):
+        self.ctx, self.timings, self.name = ctx, timings, name
+
+    def __enter__(self):
+        import time
+
+        self.t0 = time.perf_counter()
+        return self.ctx.__enter__()
+
+    def __exit__(self, *exc):
+        import time
+
+        self.timings[self.name] = round(time.perf_counter() - self.t0, 2)
+        return self.ctx.__exit__(*exc)
+
+
+def main_job_verdict(s: dict, out: str | Path, fmu_lines: list[str], fmu: bool = True) -> list[str]:
+    """What the main job ends with: the facts that hold (and, for each that does not, its failed conditions), the
+    FMU checks (the FMU half's own lines), where the report is."""
+    out = Path(out)
+    facts = s["paper_facts"]
+    ok = [f for f in facts if f["holds"]]
+    p = s["inputs"]["parameters"]["source"]
+    lines = [f"Main job on {p} ({s['inputs']['grid']['mode']} grids): {len(ok)} of {len(facts)} paper facts hold"
+             + (f" ({', '.join(str(f['id']) for f in ok)})" if ok and len(ok) < len(facts) else "") + "."]
+    for f in facts:
+        if not f["holds"]:
+            failed = [c for c in f.get("conditions", []) if not c["holds"]]
+            rotor = all(c["kind"] == "the paper's rotor" for c in failed) and failed
+            lines.append(f"  fact {f['id']} does not hold: " + "; ".join(f"{c['condition']} (ours {c['ours']})"
+                                                                        for c in failed)
+                         + (" - numbers of the paper's rotor, not a defect of this configuration" if rotor else ""))
+    if fmu:
+        lines += fmu_lines or ["FMU checks: none reported"]
+    else:
+        lines.append("FMUs: not built (--no-fmu)")
+    lines.append(f"report: {out / 'report.md'}; summary: {out / 'summary.json'}; figures in {out}/*/")
+    return lines

@@ -5,7 +5,6 @@ one stable.
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -14,22 +13,26 @@ import numpy as np
 from ..analyses.maps import StabilityMap, run_stability_map
 from ..analyses.stability import stability_of
 from ..analyses.static import solve_static
-from ..analyses.transient import TransientResult, run_transient
+from ..analyses.transient import (  # noqa: F401 - the growth verdict's names, used here and by the FMU side
+    DIVERGENCE_FIT_R2,
+    DIVERGENCE_GROWTH,
+    NO_GROWTH,
+    TransientResult,
+    envelope_grows,
+    envelope_growth,
+    run_transient,
+)
 from ..contact import make_contact
 from ..errors import ParameterError
-from ..results import pyplot, save_figure, write_json
+from ..plotting import pyplot, save_figure
+from ..progress import say, stage
 from ..structure.model import Model
+from ..writing import write_json
 
 PAPER_POINT = (3.3, 0.8e-3)  # the paper's transient point (normalised speed, g0 [m])
 PAPER_PARTIAL = 0.88  # the paper's third blade touches over 88 % of its chord at that point
-# The divergence verdict (see diverging): the envelope grows 1.5-fold or more over the run's second half at a
-# steady exponential rate. Measured on 7 configurations x 2D/3D at their transient points (20 s runs): the
-# stable static solutions' runs reach at most 1.14 (a 3D run with a ten times stiffer contact), the
-# unstable ones whose rate shows in 20 s at least 1.6; the log-linear fits have R^2 >= 0.97 both ways, so
-# the R^2 bound only keeps a limit cycle's flat, noisy envelope from counting.
-DIVERGENCE_GROWTH = 1.5
-DIVERGENCE_FIT_R2 = 0.9
-NO_GROWTH = {"rate_per_s": None, "factor": None, "window_s": None, "fit_r2": None}
+QUICK_GRID = (40, 36)  # the quick maps' speeds x clearances (the clearances spaced quadratically)
+FULL_GRID = (100, 100)
 
 
 def first_critical(model: Model) -> tuple[float, float]:
@@ -67,8 +70,8 @@ def default_grid(model: Model, quick: bool) -> tuple[np.ndarray, np.ndarray]:
     lo, hi = max(c1 - 0.8, 0.05), min(c1 + 0.8, model.params.normalisation.speed_max)
     gmax = 1.6 * peak
     if quick:
-        return np.linspace(lo, hi, 40), gmax * np.linspace(0.0, 1.0, 36) ** 2
-    return np.linspace(lo, hi, 100), np.linspace(0.0, gmax, 100)
+        return np.linspace(lo, hi, QUICK_GRID[0]), gmax * np.linspace(0.0, 1.0, QUICK_GRID[1]) ** 2
+    return np.linspace(lo, hi, FULL_GRID[0]), np.linspace(0.0, gmax, FULL_GRID[1])
 
 
 def run_stability_study(model: Model, out: str | Path, quick: bool = False, speeds=None, g0s=None,
@@ -103,25 +106,12 @@ def run_stability_study(model: Model, out: str | Path, quick: bool = False, spee
     return summary
 
 
-def _plot_pair(maps: dict[str, StabilityMap], path: Path) -> None:
-    """2D over 3D: blades in contact (left) and stability (right), the flat colours' legend below."""
-    from ..analyses.maps import category_handles, draw_contact_panel, draw_stability_panel
+def _plot_pair(maps: dict[str, StabilityMap], path: Path) -> Path:
+    """2D over 3D: blades in contact (left) and stability (right), one colour scale per column, the flat colours'
+    legend below (analyses.maps.maps_figure)."""
+    from ..analyses.maps import maps_figure
 
-    plt = pyplot()
-    fig, axes = plt.subplots(2, 2, figsize=(11, 8.6), sharex=True, sharey=True)
-    for row, f in enumerate(("2D", "3D")):
-        draw_contact_panel(fig, axes[row, 0], maps[f])
-        draw_stability_panel(fig, axes[row, 1], maps[f])
-        axes[row, 0].set_ylabel(f"{f}: initial clearance g0 [mm]")
-        for ax in axes[row]:
-            ax.set_xlabel("normalised spin speed Ω / Ω_ref [-]" if row == 1 else "")
-    axes[0, 0].set_title("blades in contact")
-    axes[0, 1].set_title("stability of the static solution")
-    h = category_handles(list(maps.values()))
-    fig.legend(handles=h, loc="lower center", ncol=min(len(h), 3), fontsize=8.5, frameon=False,
-               bbox_to_anchor=(0.5, 0.0))
-    fig.tight_layout(rect=(0, 0.06, 1, 1))
-    save_figure(fig, path, dpi=110, layout=False)
+    return save_figure(maps_figure(maps), path, dpi=110, layout=False)
 
 
 def point_status(model: Model, speed: float, g0: float) -> dict:
@@ -316,24 +306,22 @@ class TransientStudy:
         # and the blades still ring, so the chord fraction there is a snapshot of a transient
         fr_end = r3.outputs["fraction"][-1] if len(r3.t) else np.zeros(0)
         touching_end = fr_end[fr_end > 0]
-        st2 = self.statics["2D"]["static"]
-        none = dict(NO_GROWTH)
-        g2 = growth_after_ramp(r2, st2.q) if st2.converged else none
-        g3 = growth_after_ramp(r3, st3.q) if st3.converged else none
+        # the runs' own verdicts (analyses/transient.py): the same numbers as transient_2D.json, transient_3D.json
+        g2, g3 = r2.envelope_growth, r3.envelope_growth
         return {
             "speed": self.speed,
             "g0_mm": self.g0 * 1e3,
-            # diverged: blew through the liner, or oscillates away from the static solution with an
-            # envelope that grows 1.5-fold or more over the run's second half (diverging)
-            "diverged_2d": verdict(r2, g2),
-            "diverged_3d": verdict(r3, g3),
+            # diverged: either of the two below (one meaning in every file: the runs' own JSON say the same)
+            "diverged_2d": r2.diverged,
+            "diverged_3d": r3.diverged,
+            "penetration_limit_hit": {"2D": r2.penetration_limit_hit, "3D": r3.penetration_limit_hit},
+            "envelope_growing": {"2D": r2.envelope_growing, "3D": r3.envelope_growing},
+            "envelope_growth": {"2D": g2, "3D": g3},
+            "verdicts": {"2D": r2.verdict(), "3D": r3.verdict()},
             "verdict_note": "" if g2["factor"] is not None and g3["factor"] is not None else
-            "a run shorter than 4 s, or without a static solution to measure from, gets no growth verdict: "
-            "diverged is null unless the penetration limit was hit (the envelope's growth is fitted over the "
-            "second half of a run of at least 4 s)",
+            "a run shorter than 4 s gets no growth verdict: diverged is null unless the penetration limit was hit "
+            "(the envelope's growth is fitted over the second half of a run of at least 4 s)",
             "point": self.point.summary() if self.point else {"source": "given"},
-            "penetration_limit_hit": {"2D": r2.diverged, "3D": r3.diverged},
-            "growth_after_ramp": {"2D": g2, "3D": g3},
             "settled_3d": settled(r3, st3.q) if st3.converged else False,
             "blades_in_contact_2d_at_1s": r2.blades_in_contact(i2),
             "blades_in_contact_3d_at_1s": r3.blades_in_contact(i3),
@@ -349,10 +337,11 @@ class TransientStudy:
             "messages": {"2D": r2.message, "3D": r3.message},
         }
 
-    def plot(self, path: str | Path) -> Path:
-        """2D and 3D forces side by side (each on its own scale: a diverging 2D run would flatten the 3D one);
-        a blade keeps its colour in both panels and the one legend sits right of them, outside the data."""
-        from ..results import plot_blade_forces
+    def figure(self):
+        """2D and 3D forces side by side (each on its own scale: a diverging 2D run would flatten the 3D one), each
+        run's verdict in its title; a blade keeps its colour in both panels and the one legend sits right of them,
+        outside the data."""
+        from ..plotting import plot_blade_forces
 
         plt = pyplot()
         fig, axes = plt.subplots(1, 2, figsize=(12, 4.2))
@@ -360,7 +349,7 @@ class TransientStudy:
             r = self.runs[f]
             plot_blade_forces(ax, r.t, r.outputs["F_N"])
             ax.axvline(1.0, color="k", lw=0.6, ls=":", label="end of the imbalance ramp (1 s)")
-            ax.set_title(f"{f}: normal contact forces" + (" — diverged" if r.diverged else ""))
+            ax.set_title(f"{f}: {r.verdict()}", fontsize=8.5)
             ax.set_xlabel("time [s]")
             ax.set_ylabel("normal contact force F_N [N]")
             ax.grid(alpha=0.3)
@@ -372,16 +361,17 @@ class TransientStudy:
                                              else 0))
         fig.legend([seen[k] for k in labels], labels, loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize=8,
                    frameon=False)
-        fig.suptitle(f"Ω = {self.speed:.3g} Ω_ref, g0 = {self.g0 * 1e3:.3g} mm (imbalance ramped in over 1 s)")
+        fig.suptitle(f"Normal contact forces, Ω = {self.speed:.3g} Ω_ref, g0 = {self.g0 * 1e3:.3g} mm (imbalance "
+                     "ramped in over 1 s)")
         fig.tight_layout()
-        return save_figure(fig, path, layout=False)
+        return fig
 
     def save(self, out: str | Path) -> dict:
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
         for f, r in self.runs.items():
             r.save(out, stem=f"transient_{f}")
-        self.plot(out / "contact_forces.png")
+        save_figure(self.figure(), out / "contact_forces.png", layout=False)
         s = self.summary()
         write_json(out / "summary.json", s)
         return s
@@ -398,52 +388,18 @@ def _max_real(status: dict) -> float | None:
     return status["stability"].max_real if status["stability"] is not None else None
 
 
-def envelope_growth(t: np.ndarray, y: np.ndarray, t_from: float | None = None, kind: str = "max") -> dict:
-    """Growth of the envelope of a signal at the end of a run: rate [1/s] and factor.
-
-    The envelope is y's largest value (``kind="max"``) or its peak-to-peak range (``"ptp"``) over
-    windows of 0.25 s; the rate a least-squares fit of its log over the second half of the run (from
-    ``t_from``, default max(half the run, 2 s)): by then the ringing the ramp left has decayed at the
-    stable modes' rates and what remains grows, or decays, at the rate of the static solution's leading
-    eigenvalue, whatever the ringing's size. (Dividing the end's envelope by the one at 2 s, as this did,
-    took an 18-blade rotor growing 10x at +0.16 1/s for settled: its ringing at 2 s was larger still.)
-    ``factor`` = exp(rate x window): the growth over that window. None where the run is shorter than 4 s.
-    """
-    if len(t) < 4 or t[-1] < 4.0:
-        return dict(NO_GROWTH)
-    t0 = max(0.5 * float(t[-1]), 2.0) if t_from is None else float(t_from)
-    edges = np.arange(t0, t[-1] + 1e-12, 0.25)
-    env, tc = [], []
-    for a, b in zip(edges[:-1], edges[1:]):
-        sel = (t >= a) & (t < b)
-        if sel.any():
-            env.append(np.ptp(y[sel]) if kind == "ptp" else y[sel].max())
-            tc.append(0.5 * (a + b))
-    if len(env) < 4:
-        return dict(NO_GROWTH)
-    log_env = np.log(np.maximum(np.array(env), 1e-300))
-    (rate, c0) = np.polyfit(tc, log_env, 1)
-    res = log_env - (rate * np.asarray(tc) + c0)
-    ss = float(np.sum((log_env - log_env.mean()) ** 2))
-    window = float(tc[-1] - tc[0])
-    return {"rate_per_s": float(rate), "factor": float(np.exp(rate * window)),
-            "window_s": [float(tc[0]), float(tc[-1])], "fit_r2": float(1.0 - np.sum(res**2) / ss) if ss > 0 else 0.0}
-
-
 def diverging(growth: dict) -> bool:
-    """The verdict on an :func:`envelope_growth`: the envelope grows by DIVERGENCE_GROWTH or more over the
-    second half at a steady exponential rate (log-linear fit R^2 >= DIVERGENCE_FIT_R2). A limit cycle (flat
-    envelope) or ringing that decays is not a divergence, however large."""
-    f, r2 = growth.get("factor"), growth.get("fit_r2")
-    return bool(f is not None and f >= DIVERGENCE_GROWTH and (r2 or 0.0) >= DIVERGENCE_FIT_R2)
+    """The growth verdict (analyses.transient.envelope_grows) as a bool: False where it was not measured."""
+    return bool(envelope_grows(growth))
 
 
 def verdict(run: TransientResult, growth: dict) -> bool | None:
-    """Diverged: through the penetration limit, or :func:`diverging`; None where the growth could not be
-    measured (a run shorter than 4 s) and the limit was not hit: no verdict, rather than a false one."""
-    if run.diverged:
+    """Diverged: through the penetration limit, or the envelope of ``growth`` grows; None where the growth could not
+    be measured (a run shorter than 4 s) and the limit was not hit: no verdict, rather than a false one. (A run's own
+    ``diverged`` is this with its own growth.)"""
+    if run.penetration_limit_hit:
         return True
-    return None if growth.get("factor") is None else diverging(growth)
+    return envelope_grows(growth)
 
 
 def growth_after_ramp(run: TransientResult, q_static: np.ndarray, t_from: float | None = None) -> dict:
@@ -453,11 +409,9 @@ def growth_after_ramp(run: TransientResult, q_static: np.ndarray, t_from: float 
     return envelope_growth(run.t, np.linalg.norm(run.q - q_static, axis=1), t_from)
 
 
-
-
 def settled(run: TransientResult, q_static: np.ndarray, rel: float = 0.01) -> bool:
     """Every dof within rel x its largest static value of the static solution at the end."""
-    if run.diverged or run.q.shape[0] == 0:
+    if run.penetration_limit_hit or run.q.shape[0] == 0:
         return False
     err = np.abs(run.q[-1] - q_static)
     return bool(np.all(err <= rel * np.max(np.abs(q_static))))
@@ -470,10 +424,13 @@ def run_transient_study(model: Model, out: str | Path, speed: float | None = Non
         raise ParameterError("transient point: give both --speed and --g0, or neither (automatic choice)")
     point = None
     if speed is None:
-        point = choose_transient_point(model, stab_dir, progress=progress, t_end=t_end)
+        with stage("transient: picking the point (2D unstable, 3D stable) from this configuration", progress):
+            point = choose_transient_point(model, stab_dir, progress=progress, t_end=t_end)
         speed, g0 = point.speed, point.g0
+        if progress:
+            say(f"transient: point Ω = {speed:.4g} Ω_ref, g0 = {g0 * 1e3:.4g} mm ({point.source})")
         if point.note:
-            print(f"rotorub transient: {point.note}", file=sys.stderr)
+            say(f"transient: {point.note}")
     omega = speed * model.params.normalisation.omega_ref
     statics = point_status(model, speed, g0)
     runs = {f: run_transient(model, make_contact(model, f, g0=g0), omega, t_end=t_end, progress=progress)
@@ -491,7 +448,8 @@ def run_wear_study(model: Model, out: str | Path, speed: float | None = None, g0
     if (speed is None) != (g0 is None):
         raise ParameterError("wear point: give both --speed and --g0, or neither (the transient study's point)")
     if speed is None:
-        speed, g0 = pick_transient_point(model, stab_dir, progress=progress, t_end=t_end)
+        with stage("wear: picking the transient study's point", progress):
+            speed, g0 = pick_transient_point(model, stab_dir, progress=progress, t_end=t_end)
     out = Path(out)
     summary = {"speed": speed, "g0_mm": g0 * 1e3}
     for f in ("2D", "3D"):
@@ -514,9 +472,12 @@ def run_continuation_study(model: Model, out: str | Path, speed: float | None = 
             raise ParameterError(f"maps: {exc.filename} not found; run `rotorub stability --out DIR` first") from None
     else:
         speeds, g0s = default_grid(model, quick=True)
+        if progress:
+            say("continuation: no --maps given: computing the quick stability maps first")
         maps = {f: run_stability_map(model, f, speeds, g0s, progress=progress) for f in ("2D", "3D")}
     r = run_continuation(model, maps=maps, speed=speed, quick=quick, progress=progress)
     s = r.save(out)
-    return {f: {"specials": s[f]["specials"], "boundary": s[f]["boundary"],
-                "orbits": [len(b["orbits"]) for b in s[f]["orbit_branches"]]} for f in ("2D", "3D")} | \
-        {"written": str(Path(out) / "summary.json")}
+    for f in ("2D", "3D"):  # the orbits' count per branch, as the report tabulates them
+        if f in s:
+            s[f]["orbits"] = [len(b["orbits"]) for b in s[f]["orbit_branches"]]
+    return s

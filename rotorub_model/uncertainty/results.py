@@ -14,7 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
-from ..results import pyplot, save_figure, write_json
+from ..plotting import pyplot, save_figure
+from ..writing import write_json
 from .quantities import QUANTITIES
 from .study import Study
 

@@ -234,7 +234,8 @@ def test_with_rub_the_friction_torque_slows_the_spool_by_the_balance(runs):
 
 def test_result_files(runs, tmp_path):
     ref, rub = runs
-    png = rub.plot(tmp_path / "runup.png", reference=ref)
+    rub.save(tmp_path, reference=ref, stem="runup")
+    png = tmp_path / "runup.png"
     assert png.stat().st_size > 20_000
     npz = rub.save_npz(tmp_path / "rub.npz")
     back = type(rub).load_npz(npz)

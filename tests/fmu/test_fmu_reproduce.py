@@ -15,11 +15,14 @@ FMU_KEYS = ("harnesses", "fmu_vs_library", "fmu_flavours", "coupled_run", "coupl
 
 def _summary() -> dict:
     """A summary of the shape run_fmu_part returns (numbers made up: the renderer is under test, not the runs)."""
-    tr = {"max_rel_diff_F_N_vs_library": 1e-13, "diverged": False, "blades_in_contact_at_1s": 10}
+    tr = {"max_rel_diff_F_N_vs_library": 1e-13, "diverged": False, "penetration_limit_hit": False,
+          "envelope_growing": False, "blades_in_contact_at_1s": 10}
+    grows = {**tr, "diverged": True, "envelope_growing": True,
+             "envelope_growth": {"factor": 8.6, "rate_per_s": 0.221, "window_s": [10.1, 19.9], "fit_r2": 0.99}}
     lib = {"cells": 320, "cells_same_blades_in_contact": 318, "cells_other_branch": 2, "cells_solved_by_one_only": 0,
            "same_stability_verdict_fraction": 1.0, "max_real_max_rel_diff": 1e-11}
     return {
-        "harnesses": {"transient": {"2D": tr, "3D": {**tr, "diverged": True}},
+        "harnesses": {"transient": {"2D": tr, "3D": grows},
                       "run_up": {"max_rel_diff_F_N_vs_library": 2e-13, "speed_of_peak_response": 3.5,
                                  "max_normal_force_N": 180.0},
                       "quasi_static": {"vs_library": {"2D": lib, "3D": lib}}},
@@ -35,7 +38,9 @@ def _summary() -> dict:
 def test_the_section_says_what_the_fmu_half_found():
     md = report_section(_summary())
     assert md.startswith("\n## FMU against the library") and "**1.00e-11**" in md
-    assert "| transient 3D (section 6), F_N | 1.00e-13 | diverged: True" in md
+    # the two meanings of "diverged" apart, with the growth rate (issue 25.1)
+    assert ("| transient 3D (section 6), F_N | 1.00e-13 | diverged: yes (penetration limit hit: no, force envelope "
+            "growing: yes (×8.6, +0.221 1/s))") in md
     assert "| 2D | 0.0e+00 | True |" in md and "| max friction torque [N·m] | 1234 |" in md
     assert "## Engine scenario with wear" not in md  # no wear run in this summary: no section about it
 

@@ -61,7 +61,7 @@ def _check_response_summary(out, ref_model) -> dict:
 
 def test_response_in_process(tmp_path, capsys, ref_model):
     out = tmp_path / "resp"
-    assert main(["response", "--n-speeds", N_SPEEDS, "--out", str(out)]) == 0
+    assert main(["response", "--n-speeds", N_SPEEDS, "--json", "--out", str(out)]) == 0
     captured = capsys.readouterr()
     assert captured.err == ""
     printed = json.loads(captured.out)

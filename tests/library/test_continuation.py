@@ -51,7 +51,7 @@ def settles_from_unstable(model, eq: Equilibria, omega: float, g0: float, amplit
     mu, _ = eq.critical(qs, omega, g0)
     q0, v0 = eq.unstable_start(qs, omega, g0, mu, amplitude)
     r = run_transient(model, eq.contact(g0), omega, t_end=t_end, t_ramp=0.0, q0=q0, v0=v0, record_dt=2 * dt, dt=dt)
-    assert not r.diverged
+    assert not r.penetration_limit_hit
     return (mu.real, *settled(r, eq, 2 * dt))
 
 

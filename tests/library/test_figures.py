@@ -4,20 +4,18 @@ without a solution (solved from a contact-set start, proven absent, or the solve
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from matplotlib.colors import to_rgb
 
-from rotorub_model.analyses import discretisation, maps, transient
+from rotorub_model.analyses import discretisation, maps
 from rotorub_model.analyses.detection import run_detection
 from rotorub_model.analyses.maps import NO_EQUILIBRIUM, NOT_CONVERGED, ContactSetStarts, run_stability_map
 from rotorub_model.analyses.transient import run_transient
 from rotorub_model.app import studies
 from rotorub_model.app.studies import default_grid
 from rotorub_model.contact import make_contact
-from rotorub_model.results import pyplot
+from rotorub_model.plotting import pyplot
 from rotorub_model.structure.model import build_model
 from rotorub_model.structure.params import reference_parameters
 
@@ -28,22 +26,20 @@ def det(ref_model):
 
 
 @pytest.fixture
-def captured(monkeypatch):
-    """Figures handed to save_figure by the plot methods, laid out and drawn, kept open for inspection."""
+def captured():
+    """Figures the tests draw through the result objects' figure(), laid out, drawn, closed at the end."""
     figs = []
-
-    def keep(fig, path, dpi: int = 120, layout: bool = True) -> Path:
-        if layout:
-            fig.tight_layout()
-        fig.canvas.draw()
-        figs.append(fig)
-        return Path(path)
-
-    for mod in (transient, studies, discretisation, maps):
-        monkeypatch.setattr(mod, "save_figure", keep)
     yield figs
     for f in figs:
         pyplot().close(f)
+
+
+def _drawn(figs: list, fig):
+    if fig.get_layout_engine() is None:
+        fig.tight_layout()
+    fig.canvas.draw()
+    figs.append(fig)
+    return fig
 
 
 def _legends(fig) -> list:
@@ -152,8 +148,8 @@ def test_proven_absence_and_failure_are_told_apart(stiff, monkeypatch, captured)
     s2, s3 = got["2D"].summary(), got["3D"].summary()
     assert (s2["no_equilibrium_points"], s2["not_converged_points"]) == (2, 0)
     assert (s3["no_equilibrium_points"], s3["not_converged_points"]) == (0, 2)
-    studies._plot_pair(got, Path("unused.png"))
-    labels = [t.get_text() for t in captured[-1].legends[0].get_texts()]
+    fig = _drawn(captured, maps.maps_figure(got))
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
     assert any(lab.startswith("no equilibrium") for lab in labels)
     assert any(lab.startswith("solver did not converge") for lab in labels)
 
@@ -175,8 +171,7 @@ def test_stable_and_unstable_cells_cannot_be_confused(stiff, captured):
     m, speeds, g0s = stiff
     mp = run_stability_map(m, "3D", speeds[[20, 22, 27]], g0s, executor="serial", progress=False)
     assert mp.unstable.any() and (mp.contact & ~mp.unstable).any()
-    mp.plot(Path("unused.png"))
-    fig = captured[-1]
+    fig = _drawn(captured, mp.figure())
     stable = np.array(to_rgb(maps.STABLE_COLOUR))
     scale = maps.unstable_cmap()(np.linspace(0.0, 1.0, 256))[:, :3]
     assert np.min(np.linalg.norm(scale - stable, axis=1)) > 0.5  # not one shade of the scale is near it
@@ -194,8 +189,8 @@ def test_stable_and_unstable_cells_cannot_be_confused(stiff, captured):
 def test_transient_legends_are_outside_the_data(ref_model, captured):
     runs = {f: run_transient(ref_model, make_contact(ref_model, f, g0=0.2e-3), 3.3 * 53.4, t_end=1.2)
             for f in ("2D", "3D")}
-    runs["2D"].plot(Path("unused.png"))
-    studies.TransientStudy(3.3, 0.2e-3, runs, {}).plot(Path("unused.png"))
+    _drawn(captured, runs["2D"].figure())
+    _drawn(captured, studies.TransientStudy(3.3, 0.2e-3, runs, {}).figure())
     assert len(captured) == 2
     for fig in captured:
         assert_legends_hide_nothing(fig)
@@ -207,5 +202,116 @@ def test_transient_legends_are_outside_the_data(ref_model, captured):
 
 def test_discretisation_legends_are_outside_the_data(captured):
     res = discretisation.run_blade_convergence(reference_parameters(), n_values=(2, 3), n_speeds=3)
-    res.plot(Path("unused.png"))
-    assert_legends_hide_nothing(captured[-1])
+    assert_legends_hide_nothing(_drawn(captured, res.figure()))
+
+
+# ----------------------------------------------------------------------------- issue 25.4: figures show their data
+def _synthetic_maps():
+    """Two small maps whose contact region stops at half the grid's clearances, with different growth rates."""
+    speeds, g0s = np.linspace(3.0, 4.0, 6), np.linspace(0.0, 8e-3, 9)
+    out = {}
+    for f, rate in (("2D", 1.0), ("3D", 0.01)):
+        n = np.zeros((6, 9), dtype=int)
+        n[:, :4] = 3  # contact up to g0 = 3 mm of 8
+        unstable = np.zeros((6, 9))
+        unstable[2:4, :3] = rate
+        out[f] = maps.StabilityMap(f, speeds, g0s, n, np.zeros((6, 9)), np.where(unstable > 0, unstable, -1.0),
+                                   unstable, np.ones((6, 9)))
+    return out
+
+
+def test_a_maps_clearance_axis_ends_where_its_contact_does_and_2d_3d_share_one_scale(captured):
+    """The issue: the maps' g0 axis ran to 8.5 mm for data that stopped at 3-5 mm, and 2D and 3D had their own
+    colour scales (the same colour, different growth rates)."""
+    got = _synthetic_maps()
+    fig = _drawn(captured, maps.maps_figure(got))
+    data_axes = [a for a in fig.axes if a.get_label() != "<colorbar>"]
+    top = data_axes[0].get_ylim()[1]
+    assert 3.0 < top < 4.5, top  # the grid goes to 8 mm
+    assert "cut at" in fig._suptitle.get_text() and "8 mm" in fig._suptitle.get_text()
+    meshes = [c for a in data_axes for c in a.collections if getattr(c, "norm", None) is not None
+              and type(c.norm).__name__ == "LogNorm"]
+    assert len(meshes) == 2 and meshes[0].norm is meshes[1].norm  # one scale for the 2D and the 3D panel
+    assert meshes[0].norm.vmin == pytest.approx(0.01) and meshes[0].norm.vmax == pytest.approx(1.0)
+    bars = [a for a in fig.axes if a.get_label() == "<colorbar>"]
+    assert len(bars) == 2  # one per column, not one per panel
+
+
+def test_the_modes_figure_is_in_the_fixed_frame(ref_model, captured):
+    """README and --help promise fixed-frame frequencies; the figure plotted the rotating-frame ones against Re,
+    twelve eigenvalues on top of each other near Re = 0. Now: fixed-frame frequency against the damping ratio
+    (log), each mode labelled with its nodal diameter."""
+    from rotorub_model.analyses.linear import run_modes
+
+    r = run_modes(ref_model, 3.49)
+    fig = _drawn(captured, r.figure())
+    ax = fig.axes[0]
+    assert "fixed-frame frequency" in ax.get_xlabel() and ax.get_yscale() == "log"
+    xy = ax.collections[0].get_offsets()
+    np.testing.assert_allclose(np.sort(xy[:, 0]), np.sort(r.fixed_frame_hz))
+    assert len(ax.texts) == len(r.fixed_frame_hz)
+    assert "fixed frame" in ax.get_title() and "all damped" in ax.get_title()
+
+
+def test_the_campbell_legend_names_the_dots(ref_model, captured):
+    from rotorub_model.analyses.linear import run_campbell
+
+    fig = _drawn(captured, run_campbell(ref_model, 10.0, 40).figure())
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert any("one mode at one speed" in lab for lab in labels) and any("1X" in lab for lab in labels)
+
+
+def test_the_detection_variants_read_fact_3(det, captured):
+    """detection_variants.png drew the differences on an unmarked symlog axis, fact 3's 0.0785 mm inside an
+    unreadable block at the first critical: now |difference| on a log axis, the largest of each curve marked and
+    named in the legend, fact 3's 0.1 mm bound drawn, a zoom on the first critical."""
+    fig = _drawn(captured, det.figure("variants"))
+    lower = [a for a in fig.axes[1:3]]
+    assert all(a.get_yscale() == "log" for a in lower)
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    geo = float(np.max(np.abs(det.closures["3D geometry only"] - det.closures["2D"]))) * 1e3
+    assert any(lab.startswith("|3D geometry only − 2D| (largest") and f"{geo:.3g} mm" in lab for lab in labels)
+    assert any("0.1 mm" in lab for lab in labels)
+    lo, hi = lower[1].get_xlim()
+    assert hi - lo < 0.2 * (det.speeds[-1] - det.speeds[0])  # the zoom
+
+
+def _continuation():
+    from rotorub_model.analyses.continuation.boundary import Curve
+    from rotorub_model.analyses.continuation.branch import Branch, Special
+    from rotorub_model.analyses.continuation.equilibria import Point
+    from rotorub_model.analyses.continuation.periodic import Orbit, OrbitBranch
+    from rotorub_model.analyses.continuation.study import ContinuationResult
+
+    def pt(g0, stable):
+        return Point(176.2, g0, np.zeros(2), (), 2, 100.0, 1e-4 + g0, None, -0.1 if stable else 0.1)
+
+    pts = [pt(g, g > 0.5e-3) for g in np.linspace(0.7e-3, 0.0, 15)]
+    b = Branch("2D", "g0", 176.2, pts, [Special("switch", pt(0.531e-3, False))], True, "reached g0 = 0")
+    orbits = [Orbit(176.2, g, np.zeros(4), 0.02, np.array([0.5]), 1e-4, 4e-4, 150.0, 1e-10, 5e-4, 3e-4)
+              for g in np.linspace(0.30e-3, 0.38e-3, 12)]
+    ob = OrbitBranch("2D", 176.2, orbits, "stopped after 12 orbits", notes={"start": "transient",
+                                                                             "seed_g0_m": 0.337e-3,
+                                                                             "seed_transient_s": 40.0})
+    curve = Curve([3.0, 3.2, 3.4, 3.5], [0.2e-3, 0.3e-3, 0.5e-3, 1e-3], ["switch", "switch", "fold", "fold"])
+    return ContinuationResult(3.3, {"2D": b}, {"2D": [ob]}, {"2D": [curve]}, {"2D": {}}, {})
+
+
+def test_the_continuation_figure_says_where_its_orbit_family_stops(captured):
+    """The 2D orbit family stopped at 0.38 mm, cut off from its switch at 0.531 mm, without a word."""
+    r = _continuation()
+    fig = _drawn(captured, r.figure("branches"))
+    text = " ".join(t.get_text() for t in fig.axes[0].texts).replace("\n", " ")
+    assert "truncated: stopped after 12 orbits" in text and "not followed to the switch at 0.531 mm" in text
+    assert r.summary()["2D"]["orbit_note"] == r.orbit_note("2D")
+
+
+def test_the_boundaries_legend_matches_what_is_drawn(captured):
+    """boundaries.png had a black legend line for coloured curves: each segment is now drawn in its kind's colour,
+    and the legend has exactly the kinds drawn, as lines of those colours."""
+    fig = _drawn(captured, _continuation().figure("boundaries"))
+    ax = fig.axes[0]
+    leg = {t.get_text(): h for t, h in zip(ax.get_legend().get_texts(), ax.get_legend().legend_handles)}
+    assert set(leg) == {"boundary: contact-induced switch", "boundary: fold"}
+    drawn = {to_rgb(ln.get_color()) for ln in ax.get_lines()}
+    assert {to_rgb(h.get_color()) for h in leg.values()} == drawn

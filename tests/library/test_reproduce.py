@@ -114,3 +114,17 @@ def test_main_job_wears_the_liner_at_the_transient_point(run):
         assert (out / "wear" / f / "wear_profile.png").exists() and (out / "wear" / f / "wear_map.png").exists()
     text = (out / "report.md").read_text()
     assert "against an abradable liner" in text and "wear/3D/wear_map.png" in text
+
+
+def test_main_job_reports_the_quick_forced_response_and_uncertainty(run):
+    """Issue 25.3: the quick harmonic-balance and uncertainty sections are in the main job's report, their figures
+    linked from the report's folder, and every stage's time is in the summary (what the main job is made of)."""
+    out, summary = run
+    text = (out / "report.md").read_text()
+    assert "## Forced response of an offset casing (harmonic balance)" in text
+    assert "## Will it rub? Uncertainty (quick)" in text
+    assert "(forced_response/interaction_map.png)" in text
+    assert (out / "forced_response" / "interaction_map.png").exists()
+    t = summary["timings_s"]
+    assert set(t) >= {"linear", "detection", "stability", "transient", "wear", "continuation", "forced_response",
+                      "uncertainty"} and all(v > 0 for v in t.values())

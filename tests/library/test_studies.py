@@ -59,7 +59,7 @@ def test_eighteen_blades_diverge_at_the_rate_of_their_eigenvalue(eighteen_blades
     assert (s["speed"], s["g0_mm"]) == (3.3, pytest.approx(0.8))
     lam2, lam3 = st["2D"]["stability"].max_real, st["3D"]["stability"].max_real
     assert lam2 > 0.1 and lam3 < 0  # the oracle: 2D unstable, 3D stable (measured +0.160, -0.029)
-    g2, g3 = s["growth_after_ramp"]["2D"], s["growth_after_ramp"]["3D"]
+    g2, g3 = s["envelope_growth"]["2D"], s["envelope_growth"]["3D"]
     assert g2["rate_per_s"] == pytest.approx(lam2, rel=0.1)  # measured 0.163
     assert g2["factor"] > DIVERGENCE_GROWTH and s["diverged_2d"]
     assert g3["rate_per_s"] < 0 and not s["diverged_3d"] and s["settled_3d"]

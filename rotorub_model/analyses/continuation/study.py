@@ -27,8 +27,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ...results import pyplot, save_figure, write_json
+from ...plotting import pyplot, save_figure
+from ...progress import say, stage
 from ...structure.model import Model
+from ...writing import write_json
 from ..maps import StabilityMap
 from ..transient import run_transient
 from .boundary import Curve, nearest_on_polyline, trace_boundaries
@@ -67,6 +69,7 @@ class ContinuationResult:
                      "message": ob.message, "hopf_g0_m": ob.hopf_g0, "hopf_frequency_rad_s": ob.hopf_frequency,
                      "orbits": [o.summary() for o in ob.orbits], **ob.notes}
                     for ob in self.orbits.get(f, [])],
+                "orbit_note": self.orbit_note(f),
                 "boundary": {"curves": len(self.curves.get(f, [])),
                              "points": sum(len(c) for c in self.curves.get(f, [])),
                              "kinds": sorted({k for c in self.curves.get(f, []) for k in c.kinds}),
@@ -74,13 +77,46 @@ class ContinuationResult:
             }
         return out
 
-    def plot(self, path: str | Path) -> Path:
-        """Bifurcation diagrams in g0: the fan-disk centre's distance from the axis, for the static
-        solutions and (its largest and smallest over the period) for the orbits: the same quantity, so
-        that an orbit born at a Hopf point starts on its static branch."""
+    def orbit_note(self, f: str) -> str:
+        """What the figure says about the orbit family of one formulation: where it started, how far it was
+        followed, and where it stops short of the special point it belongs to (a truncated family said so)."""
+        obs = [ob for ob in self.orbits.get(f, []) if ob.orbits]
+        if not obs:
+            msgs = "; ".join(ob.message for ob in self.orbits.get(f, []) if ob.message)
+            return f"no periodic orbit{': ' + msgs if msgs else ''}"
+        g = np.array([o.g0 for ob in obs for o in ob.orbits]) * 1e3
+        ob0 = obs[0]
+        if ob0.hopf_g0 is not None:
+            start = f"born at the Hopf point, g0 = {ob0.hopf_g0 * 1e3:.4g} mm"
+        else:
+            seed = ob0.notes.get("seed_g0_m")
+            start = (f"from a {ob0.notes.get('seed_transient_s', 0):.0f} s transient at g0 = {seed * 1e3:.4g} mm"
+                     if seed is not None else "from a transient")
+        note = f"orbits {start}, followed over g0 = {g.min():.4g}-{g.max():.4g} mm"
+        stopped = [ob.message for ob in obs if ob.message.startswith("stopped after")]
+        if stopped:
+            note += f"; truncated: {stopped[0]} per direction (the quick study's cap)"
+        b = self.branches.get(f)
+        sw = [sp.point.g0 * 1e3 for sp in (b.specials if b else []) if sp.kind in ("switch", "hopf", "fold")]
+        far = [x for x in sw if x > g.max() * 1.02 or x < g.min() * 0.98]
+        if far:
+            note += f"; not followed to the {'switch' if b.of_kind('switch') else 'special point'} at {far[0]:.4g} mm"
+        return note
+
+    def figure(self, kind: str = "branches"):
+        """``"branches"``: the bifurcation diagrams in g0 (the fan-disk centre's distance from the axis, for the
+        static solutions and, its largest and smallest over the period, for the orbits: the same quantity, so that
+        an orbit born at a Hopf point starts on its static branch), each with a note of how far its orbit family
+        was followed; ``"boundaries"``: the stability boundary curves over the grid maps."""
+        if kind == "boundaries":
+            return self._figure_boundaries()
+        if kind != "branches":
+            from ...errors import ParameterError
+
+            raise ParameterError(f"kind: '{kind}' unknown; accepted: branches, boundaries")
         plt = pyplot()
-        fig, axes = plt.subplots(1, max(len(self.branches), 1), figsize=(6 * max(len(self.branches), 1), 4.5),
-                                 squeeze=False)
+        fig, axes = plt.subplots(1, max(len(self.branches), 1), figsize=(6 * max(len(self.branches), 1), 5.0),
+                                 squeeze=False, layout="constrained")
         for ax, (f, b) in zip(axes[0], self.branches.items()):
             ax.set_title(f"{f}, Ω = {self.speed:g} Ω_ref")
             ax.set_xlabel("clearance g0 [mm]")
@@ -103,55 +139,74 @@ class ContinuationResult:
                     ax.plot(go[~so], ro[~so], "o", mfc="none", color="C3", ms=4, label="periodic, unstable")
             marks = {"hopf": ("^", "C2", "Hopf"), "fold": ("s", "k", "fold"), "switch": ("D", "C1", "switch"),
                      "unlocated": ("X", "C4", "stability change, unlocated")}
-            for kind, (m, c, lab) in marks.items():
-                sp = b.of_kind(kind)
+            for kind_, (m, c, lab) in marks.items():
+                sp = b.of_kind(kind_)
                 if sp:
                     ax.plot([s.point.g0 * 1e3 for s in sp], [s.point.disk_amplitude * 1e3 for s in sp], m, color=c,
                             ms=8, label=lab)
             touching = [p.g0 for p in b.points if p.n_contact > 0]
             if touching and max(touching) > 0:  # the contact part of the branch, with the first clearance-only stretch
                 ax.set_xlim(0.0, 1.3 * max(touching) * 1e3)
+            ax.text(0.01, 0.01, _wrap(self.orbit_note(f), 70), transform=ax.transAxes, fontsize=7, va="bottom",
+                    ha="left", bbox={"facecolor": "white", "alpha": 0.85, "edgecolor": "0.7"})
             _legend(ax)
-        return save_figure(fig, path)
+        return fig
 
-    def plot_boundaries(self, path: str | Path) -> Path:
+    def _figure_boundaries(self):
+        """The boundary curves, each segment in the colour of its kind (a contact-induced switch, a Hopf curve, a
+        fold), over the grid maps' verdicts; the legend names only what is drawn."""
+        from matplotlib.lines import Line2D
+
         plt = pyplot()
-        fig, axes = plt.subplots(1, len(self.curves), figsize=(6 * len(self.curves), 4.5), squeeze=False)
+        fig, axes = plt.subplots(1, max(len(self.curves), 1), figsize=(6 * max(len(self.curves), 1), 4.8),
+                                 squeeze=False, layout="constrained")
+        colours = {"switch": "C1", "hopf": "C0", "fold": "C4"}
+        names = {"switch": "boundary: contact-induced switch", "hopf": "boundary: Hopf", "fold": "boundary: fold"}
         for ax, (f, cs) in zip(axes[0], self.curves.items()):
+            handles = []
             mp = self.maps.get(f)
             if mp is not None:
                 S, G = np.meshgrid(mp.speeds, mp.g0s * 1e3, indexing="ij")
-                ax.scatter(S[mp.unstable], G[mp.unstable], s=6, c="C3", label="grid: unstable")
-                ax.scatter(S[mp.contact & ~mp.unstable], G[mp.contact & ~mp.unstable], s=6, c="C2",
-                           label="grid: stable, contact")
-                ax.scatter(S[mp.no_solution], G[mp.no_solution], s=8, c="k", marker="x", label="grid: no equilibrium")
-            for i, c in enumerate(cs):
+                for mask, kw, lab in ((mp.unstable, {"c": "C3", "s": 6}, "grid: unstable"),
+                                      (mp.contact & ~mp.unstable, {"c": "C2", "s": 6}, "grid: stable, contact"),
+                                      (mp.no_solution, {"c": "k", "s": 8, "marker": "x"}, "grid: no equilibrium")):
+                    if mask.any():
+                        handles.append(ax.scatter(S[mask], G[mask], label=lab, **kw))
+            drawn = set()
+            for c in cs:
                 k = np.array(c.kinds)
                 s, g = np.array(c.speeds), np.array(c.g0s) * 1e3
-                ax.plot(s, g, "-", color="k", lw=1.2, label="boundary (continuation)" if i == 0 else None)
-                for kind, col in (("hopf", "C0"), ("switch", "C1"), ("fold", "C4")):
-                    sel = k == kind
-                    if sel.any():
-                        ax.plot(s[sel], g[sel], ".", color=col, ms=2, label=kind)
-            ax.set_xlabel("Ω / Ω_ref")
+                for i in range(len(s) - 1):  # each segment in the colour of the point it starts from
+                    kind = k[i] if k[i] in colours else "switch"
+                    ax.plot(s[i:i + 2], g[i:i + 2], "-", color=colours[kind], lw=1.8, solid_capstyle="round")
+                    drawn.add(kind)
+            handles += [Line2D([], [], color=colours[k], lw=1.8, label=names[k]) for k in colours if k in drawn]
+            ax.set_xlabel("normalised spin speed Ω / Ω_ref [-]")
             ax.set_ylabel("clearance g0 [mm]")
             ag = self.agreement.get(f, {})
             ax.set_title(f"{f}: stability boundary; grid cells off the curve's verdict: "
                          f"{ag.get('contradicting_cells', '?')} ({ag.get('contradicting_beyond_one_cell', '?')} beyond "
                          "one cell)", fontsize=8)
-            _legend(ax)
+            ax.legend(handles=handles, fontsize=7)
             ax.grid(alpha=0.3)
-        return save_figure(fig, path)
+        return fig
 
     def save(self, out: str | Path) -> dict:
+        """continuation.png (the branches), boundaries.png (the curves over the maps) and summary.json."""
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
-        self.plot(out / "continuation.png")
+        save_figure(self.figure("branches"), out / "continuation.png")
         if self.curves:
-            self.plot_boundaries(out / "boundaries.png")
+            save_figure(self.figure("boundaries"), out / "boundaries.png")
         s = self.summary()
         write_json(out / "summary.json", s)
         return s
+
+
+def _wrap(text: str, width: int) -> str:
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, width))
 
 
 def _joined(b: Branch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -403,19 +458,22 @@ def run_continuation(model: Model, maps: dict[str, StabilityMap] | None = None, 
     for f in formulations:
         eq = Equilibria(model, f)
         t0 = time.perf_counter()
-        b = continue_static(eq, "g0", omega, float(np.max(g0s)), 0.0)
+        with stage(f"continuation {f}: static branch in g0 at Ω = {speed:.4g} Ω_ref", progress, done=False):
+            b = continue_static(eq, "g0", omega, float(np.max(g0s)), 0.0)
         branches[f] = b
         timings[f"branch_{f}"] = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        orbits[f] = _orbits(eq, b, omega, max_orbits) if b.points else []
-        timings[f"orbits_{f}"] = time.perf_counter() - t0
         if progress:
             n_contact = len(b.of_kind("contact"))  # as the summary counts them: contact events apart
-            print(f"continuation {f}: branch {len(b.points)} points, {len(b.specials) - n_contact} special points "
-                  f"and {n_contact} contact events")
+            say(f"continuation {f}: branch {len(b.points)} points, {len(b.specials) - n_contact} special points "
+                f"and {n_contact} contact events ({timings[f'branch_{f}']:.1f} s)")
+        t0 = time.perf_counter()
+        with stage(f"continuation {f}: periodic orbits past the loss of stability (at most {max_orbits})", progress):
+            orbits[f] = _orbits(eq, b, omega, max_orbits) if b.points else []
+        timings[f"orbits_{f}"] = time.perf_counter() - t0
         if boundaries:
             t0 = time.perf_counter()
-            cv, info = trace_boundaries(eq, np.asarray(speeds), np.asarray(g0s))
+            with stage(f"continuation {f}: stability boundary as curves over the maps' range", progress):
+                cv, info = trace_boundaries(eq, np.asarray(speeds), np.asarray(g0s))
             curves[f] = cv
             timings[f"boundary_{f}"] = time.perf_counter() - t0
             agree[f] = {"evaluations": info["evaluations"], "resolution_cells": info["resolution_cells"],
