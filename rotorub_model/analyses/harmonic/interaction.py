@@ -324,7 +324,7 @@ def run_interaction_map(model: Model, formulation: str = "2D", speed_range: tupl
                      "t_end": float(t_end), "wears": False} for s in speeds]
         res = run_tasks(forced_transient, payloads, executor=executor, progress=progress, desc="transients")
         tr = {"speed": speeds, "kind": np.array([int(r["kind"]) for r in res]),
-              "spread": np.array([float(r["spread"]) for r in res])}
+              "remaining": np.array([float(r["remaining"]) for r in res])}
         for key in ("tip_amplitude", "max_force", "disk_amplitude", "penetration"):
             tr[key] = np.array([float(r[key]) if key in r and KINDS[int(r["kind"])] != "divergent" else math.nan
                                 for r in res])

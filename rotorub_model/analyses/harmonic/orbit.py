@@ -84,27 +84,9 @@ class OrbitView:
         self.F_N, self.gaps = self._laws()
 
     def _laws(self) -> tuple[np.ndarray, np.ndarray]:
-        pb = self.problem
-        c = pb.contact
-        lib = c.lib
-        N, P = c.n_blades, c.n_points
-        from ... import kernel
-
-        F = np.empty((self.fine.m, N))
-        G = np.empty((self.fine.m, N, P))
-        gaps, law = np.empty(N * P), np.empty((N, kernel.LAW_WIDTH))
-        surface = pb.liner.struct if pb.liner is not None else None
-        phi0 = surface.phi if surface is not None else 0.0
-        for i in range(self.fine.m):
-            if surface is not None:
-                surface.phi = float(self.phi[i])
-            qi = np.ascontiguousarray(self.q[i])
-            lib.rr_laws(pb._vref, kernel.ptr(qi), kernel.ptr(gaps), kernel.ptr(law))
-            F[i] = law[:, 0]
-            G[i] = gaps.reshape(N, P)
-        if surface is not None:
-            surface.phi = phi0
-        return F, G
+        """Blade normal forces (m, N) and gaps (m, N, P) at the fine samples, each at its own frame angle."""
+        gaps, law = self.problem.nl.laws(self.q, self.phi if self.problem.forced else None)
+        return law[:, :, 0], gaps
 
     def measures(self) -> OrbitMeasures:
         m = measures_from_states(self.problem.model, self.q, self.F_N, self.gaps, self.problem.H)
