@@ -152,3 +152,40 @@ def hopf_start(problem: HBProblem, q_static: np.ndarray, omega: float, mu: compl
     dY[1] = y1.real  # Re(y1 e^{i tau}) = Re y1 cos - Im y1 sin
     dY[2] = -y1.imag
     return Y0.ravel(), abs(mu.imag), (dY.ravel(), 0.0, 0.0)
+
+
+def section_phase(problem: HBProblem, Q: np.ndarray, dof: int, grid: int = 512) -> float:
+    """The phase tau* at which dof's velocity vanishes where the dof is largest: the HB orbit's point on the
+    section a shooting takes (q'_dof(0) = 0), to compare orbits whose time origins differ. Q: (2H+1, n)."""
+    from scipy.optimize import brentq
+
+    b = problem.basis
+    c = Q[:, dof : dof + 1]
+    dc = b.derivative() @ c
+
+    def vel(tau: float) -> float:
+        return float(b.evaluate(dc, np.array([tau]))[0, 0])
+
+    taus = np.linspace(0.0, 2 * math.pi, grid + 1)
+    v = b.evaluate(dc, taus)[:, 0]
+    roots = [brentq(vel, taus[i], taus[i + 1], xtol=1e-15) for i in range(grid) if v[i] * v[i + 1] < 0]
+    if not roots:
+        raise ValueError(f"dof {dof} does not oscillate on this orbit")
+    return max(roots, key=lambda t: float(b.evaluate(c, np.array([t]))[0, 0]))
+
+
+def section_state(problem: HBProblem, Y: np.ndarray, omega: float, w: float, dof: int) -> tuple[float, np.ndarray]:
+    """(tau*, x*) the HB orbit's phase and state (q, q') on the section q'_dof = 0 at the dof's largest value."""
+    Q = problem.full(Y, omega, w)
+    tau = section_phase(problem, Q, dof)
+    b = problem.basis
+    q = b.evaluate(Q, np.array([tau]))[0]
+    v = w * b.evaluate(b.derivative() @ Q, np.array([tau]))[0]
+    return tau, np.concatenate([q, v])
+
+
+def seed_from_samples(problem: HBProblem, q: np.ndarray) -> np.ndarray:
+    """Y (raveled) of one period of full states q (N, n) sampled at N equal steps (a settled transient's, a
+    shooting orbit's): the contact coordinates' Fourier coefficients up to the problem's H (N > 2 H)."""
+    b = HarmonicBasis(problem.H, q.shape[0])
+    return b.to_coefficients(np.asarray(q) @ problem.P.T).ravel()

@@ -178,7 +178,7 @@ class _Tracer:
 
 def continue_hb(problem: HBProblem, parameter: str, start: float, stop: float, fixed: float,
                 Y0: np.ndarray | None = None, h_max: float = 0.05, max_points: int = 2000, stability: bool = True,
-                substeps: int | None = DEFAULT_SUBSTEPS, progress=None, autonomous: bool = False,
+                substeps: float | None = DEFAULT_SUBSTEPS, progress=None, autonomous: bool = False,
                 w0: float | None = None, start_tangent: tuple[np.ndarray, float, float] | None = None,
                 y_scale: float | None = None) -> HBBranch:
     """Follow the HB orbit from ``parameter = start`` to ``stop`` (``omega`` [rad/s] at g0 = ``fixed``, or
