@@ -180,14 +180,15 @@ def continue_hb(problem: HBProblem, parameter: str, start: float, stop: float, f
                 Y0: np.ndarray | None = None, h_max: float = 0.05, max_points: int = 2000, stability: bool = True,
                 substeps: float | None = DEFAULT_SUBSTEPS, progress=None, autonomous: bool = False,
                 w0: float | None = None, start_tangent: tuple[np.ndarray, float, float] | None = None,
-                y_scale: float | None = None) -> HBBranch:
+                y_scale: float | None = None, halt=None) -> HBBranch:
     """Follow the HB orbit from ``parameter = start`` to ``stop`` (``omega`` [rad/s] at g0 = ``fixed``, or
     ``g0`` [m] at Omega = ``fixed``). ``h_max``: the largest step as a fraction of the range (and of y_s).
 
     Forced orbits (default): w = Omega. ``autonomous``: the orbit's frequency is an unknown (start ``w0``) and a
     phase condition fixes its time origin (:func:`.autonomous.phase_index`: the sine of harmonic 1 of the
     coordinate that moves most vanishes); ``start_tangent`` (dY, dw, dp) starts the branch at (Y0, w0) as it is
-    (a Hopf point: the static solution, any w) along that direction, instead of a Newton solve there."""
+    (a Hopf point: the static solution, any w) along that direction, instead of a Newton solve there.
+    ``halt(point) -> str | None``: a reason to end the branch at this point (the map's bound on the amplitude)."""
     if parameter not in ("omega", "g0"):
         raise ParameterError(f"parameter: '{parameter}' unknown; accepted: omega, g0")
     if not (math.isfinite(start) and math.isfinite(stop)) or start == stop:
@@ -265,6 +266,11 @@ def continue_hb(problem: HBProblem, parameter: str, start: float, stop: float, f
         if progress is not None:
             progress(new)
         z, t, det_sign = z_new, t_new, sign_new
+        reason = halt(new) if halt is not None else None
+        if reason:
+            message = f"stopped at {parameter} = {tr.unpack(z)[1]:.6g}: {reason}"
+            complete = False
+            break
         if complete:
             break
         h = min(h * (1.5 if its <= 3 else 1.0 if its <= 5 else 0.5), h_max)

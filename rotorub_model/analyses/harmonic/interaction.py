@@ -31,8 +31,8 @@ from ...structure.model import Model
 from ...structure.params import to_dict
 from ..linear import first_order
 from ..sweeps import run_tasks
-from .continuation import HBBranch, continue_hb
-from .orbit import OrbitView, profile_lobes
+from .continuation import HBBranch, HBPoint, continue_hb
+from .orbit import OrbitView, profile_lobes, tip_deflection
 from .problem import HBProblem
 from .surface import CasingForcing
 from .transients import KINDS, SETTLE_TOL, forced_transient
@@ -154,7 +154,11 @@ class InteractionMap:
         for ax, key, scale, label in ((axes[0], "tip_amplitude", 1e3, "blade-tip amplitude [mm]"),
                                       (axes[1], "max_force", 1.0, "largest contact force [N]"),
                                       (axes[2], "incursion", 1e3, "incursion / wear depth [mm]")):
-            _draw_branch(ax, s, self.hb[key] * scale, st, "HB" + (" incursion" if key == "incursion" else ""))
+            seg = self.hb.get("segment", np.zeros(s.size, dtype=int))
+            for k in np.unique(seg):  # a branch cut where it left the model's range is drawn in its pieces
+                on = seg == k
+                _draw_branch(ax, s[on], self.hb[key][on] * scale, st[on],
+                             "HB" + (" incursion" if key == "incursion" else ""))
             ax.set_ylabel(label)
             ax.grid(alpha=0.3)
         for sp in self.branch.specials:
@@ -184,8 +188,8 @@ class InteractionMap:
                 axes[2].plot(tr["speed"], tr["wear_depth"] * 1e3, "v", color="C2", label="transient wear depth")
                 for x, y, lob in zip(tr["speed"], tr["wear_depth"] * 1e3, tr["wear_lobes"]):
                     if y > 0:
-                        axes[2].annotate(f"{int(lob)}", (x, y), textcoords="offset points", xytext=(0, 5),
-                                         fontsize=7, ha="center", color="C2")
+                        axes[2].annotate(f"{int(lob)} lobes" if lob else "even", (x, y), textcoords="offset points",
+                                         xytext=(0, 5), fontsize=7, ha="center", color="C2")
         # where the HB and the transient disagree (the agreement's verdicts): a red mark at the panel's foot
         dis = self.disagreements()
         for r in dis:
@@ -193,7 +197,8 @@ class InteractionMap:
                 ax.annotate("≠", (r["speed"], 0.02), xycoords=("data", "axes fraction"), color="red", fontsize=11,
                             ha="center", va="bottom", fontweight="bold")
         if dis:
-            axes[0].plot([], [], "none", label="≠ HB and transient disagree (why: JSON 'disagreements')")
+            axes[0].plot([], [], ls="none", marker="$≠$", color="red", ms=9,
+                         label="HB and transient disagree (why: the JSON's 'disagreements')")
         # mode crossings: dotted lines, numbered above the top panel in staggered rows, listed under the figure
         lo, hi = axes[0].get_xlim()
         rows_x: list[float] = []
@@ -261,16 +266,17 @@ def _forcing_text(f: CasingForcing) -> str:
 
 
 def _draw_branch(ax, s, y, stable, label):
-    """Stable parts solid, unstable dashed, in the branch's own order (it may fold back)."""
-    first = {True: True, False: True}
+    """Stable parts solid, unstable dashed, in the branch's own order (it may fold back); each label once."""
+    have = set(ax.get_legend_handles_labels()[1])
     i0 = 0
     for i in range(1, len(s) + 1):
         if i == len(s) or stable[i] != stable[i0]:
             seg = slice(max(i0 - 1, 0), i)
             st = bool(stable[i0])
+            lab = f"{label} stable" if st else f"{label} unstable"
             ax.plot(s[seg], y[seg], "-" if st else "--", color="C0" if st else "C1", lw=1.4,
-                    label=(f"{label} stable" if st else f"{label} unstable") if first[st] else None)
-            first[st] = False
+                    label=None if lab in have else lab)
+            have.add(lab)
             i0 = i
 
 
@@ -358,14 +364,72 @@ def hb_measures(problem: HBProblem, branch: HBBranch, omega_ref: float) -> dict[
     return out
 
 
+def tip_cap(model: Model, problem: HBProblem, contact) -> callable:
+    """The bound a followed branch must stay within: the blade-tip amplitude (the sum of its harmonics' moduli,
+    an upper bound, from the orbit's coefficients: no sampling) at most ``contact.max_penetration`` (3 mm in the
+    reference), the depth at which the transients stop as diverged. A resonance of the blades against a penalty
+    contact hardens without end: the branch climbs its backbone to amplitudes the small-displacement model does
+    not hold (measured: 5 mm at 2 Omega = blade mode 3, g0 = 0.1 mm), and a continuation there never returns."""
+    cap = float(model.params.contact.max_penetration)
+
+    def halt(p) -> str | None:
+        problem.set_clearance(p.g0)
+        tip = tip_deflection(model, problem.full(p.Y, p.omega, p.w))  # (2H+1, blades) coefficients
+        amp = float(problem.basis.amplitudes(tip)[1:].sum(axis=0).max())
+        return None if amp <= cap else (f"blade-tip amplitude above contact.max_penetration = {cap * 1e3:.3g} mm "
+                                        "(beyond the model's range: the map restarts past this speed)")
+    return halt
+
+
+def follow_segments(problem: HBProblem, start: float, stop: float, g0: float, halt, max_points: int,
+                    progress=None, restart_step: float | None = None) -> tuple[HBBranch, np.ndarray]:
+    """Continuation in Omega from ``start`` to ``stop`` in segments: a segment ends at the range's end, at
+    ``max_points``, or where ``halt`` says; the next starts at the first speed past the furthest one reached
+    (steps of ``restart_step``, 0.5 % of the range by default) where Newton from the contact-free response finds
+    an orbit within the bound. Returns the points of all segments as one branch and each point's segment."""
+    from .sweep import hb_point
+
+    step = restart_step or 0.005 * (stop - start)
+    pts, specials, msgs, seg = [], [], [], []
+    Y0, s0 = None, start
+    while True:
+        br = continue_hb(problem, "omega", s0, stop, g0, Y0=Y0, max_points=max_points, progress=progress, halt=halt)
+        k = len(msgs)
+        pts += br.points
+        specials += br.specials
+        seg += [k] * len(br.points)
+        msgs.append(f"[{s0:.4g}, ...]: {br.message}")
+        if br.complete or not br.points:
+            break
+        reached = max(p.omega for p in br.points)
+        Y0 = None
+        s = reached + step
+        while s < stop:
+            problem.set_clearance(g0)
+            p = hb_point(problem, s, None, stability=False, measure_samples=0)
+            if p.converged:
+                if halt(HBPoint(s, g0, s, p.Y)) is None:
+                    Y0, s0 = p.Y, s
+                    break
+            s += step
+        if Y0 is None:
+            msgs.append(f"no orbit within the bound found past {reached:.4g} rad/s")
+            break
+    complete = bool(pts) and abs(max(p.omega for p in pts) - stop) <= 1e-9 * stop
+    return HBBranch("omega", pts, specials, complete, "; ".join(msgs)), np.array(seg, dtype=int)
+
+
 def run_interaction_map(model: Model, formulation: str = "2D", speed_range: tuple[float, float] = (2.5, 4.5),
                         g0: float | None = None, forcing: CasingForcing | None = None, harmonics: int = 10,
                         n_transients: int = 9, t_end: float = 60.0, wear: bool = True, executor=None,
-                        progress: bool = True, out: str | Path | None = None, refine: int = 1) -> InteractionMap:
+                        progress: bool = True, out: str | Path | None = None, refine: int = 1,
+                        max_points: int = 400) -> InteractionMap:
     """HB continuation in the spin speed over ``speed_range`` (normalised) and transients at ``n_transients``
     speeds through the executor (:func:`..sweeps.run_tasks`: process pool, "serial", or a Dask executor).
     ``forcing`` defaults to an oval casing (2 lobes of 0.3 g0, widest at 0); ``refine`` divides the transients'
-    step (T/64): in 3D the fast blade mode needs 2 for the amplitudes to be within 1 % (docs/THEORY.md 8)."""
+    step (T/64): in 3D the fast blade mode needs 2 for the amplitudes to be within 1 % (docs/THEORY.md 8).
+    The branch is followed in segments (:func:`follow_segments`): one that climbs a resonance beyond the model's
+    range is cut there and the map restarts past the furthest speed it reached."""
     lo, hi = (float(v) for v in speed_range)
     smax = model.params.normalisation.speed_max
     if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi <= smax):
@@ -386,10 +450,11 @@ def run_interaction_map(model: Model, formulation: str = "2D", speed_range: tupl
         bar = tqdm(desc=f"HB continuation {formulation}", unit="orbit", total=None)
     t0 = time.perf_counter()
     with threadpool_limits(limits=1):  # small dense algebra: BLAS threads only fight on a shared machine
-        branch = continue_hb(problem, "omega", lo * wr, hi * wr, g0,
-                             progress=(lambda p: bar.update(1)) if bar is not None else None)
+        branch, seg = follow_segments(problem, lo * wr, hi * wr, g0, tip_cap(model, problem, contact),
+                                      max_points, (lambda p: bar.update(1)) if bar is not None else None)
         t_hb = time.perf_counter() - t0
         hb = hb_measures(problem, branch, wr)
+        hb["segment"] = seg
     if bar is not None:
         bar.close()
     t1 = time.perf_counter()

@@ -255,7 +255,8 @@ def autonomous_2d_case(model: Model, g0: float = 0.33e-3, speed: float = 3.3, ha
                      "orbit": float(np.abs(qhb - qex).max() / scale), "multiplier": fl.largest - rho_ex})
     cd_rows = _cd_rows(eq, om, g0, ex.x0, ex.period, dof, lambda t: sysm.sample(ex.segments, t), steps)
     return {"speed": speed, "g0_m": g0, "section_dof": model.dofs[dof],
-            "exact": {"period_s": ex.period, "events": ex.events, "largest_multiplier": rho_ex, "range_m": scale,
+            "exact": {"period_s": ex.period, "x0": ex.x0.tolist(), "events": ex.events,
+                      "largest_multiplier": rho_ex, "range_m": scale,
                       "disk_peak_to_peak_m": float(np.ptp(qex @ T2.T, axis=0).max())},
             "shooting_256": {"period": _rel(cd.period, ex.period)}, "rows": rows, "cd_rows": cd_rows}
 
@@ -314,7 +315,8 @@ def autonomous_3d_case(model: Model, g0: float = 0.3323e-3, speed: float = 3.3, 
     cd_rows = _cd_rows(eq, om, g0, ref.x0, ref.period, dof, lambda t: ref.sample(flow, t), steps)
     return {"speed": speed, "g0_m": g0, "hopf_g0_m": h.g0, "hopf_frequency_rad_s": abs(h.mu.imag),
             "section_dof": model.dofs[dof], "hb_branch": {"points": len(hb.points), "message": hb.message},
-            "reference": {"period_s": ref.period, "rtol": flow.rtol, "newton_residual": ref.residual,
+            "reference": {"period_s": ref.period, "x0": ref.x0.tolist(), "rtol": flow.rtol,
+                          "newton_residual": ref.residual,
                           "iterations": ref.iterations, "range_m": scale, "time_s": t_ref,
                           "disk_peak_to_peak_m": float(np.ptp(qref @ T2.T, axis=0).max())},
             "shooting_branch_256": {"g0_m": shot.g0, "period_s": shot.period,
