@@ -237,10 +237,11 @@ class InteractionMap:
         order = np.argsort(s)
         im = ax.pcolormesh(s[order], np.arange(Hc.shape[1]), np.log10(np.maximum(rel[order].T, 1e-8)),
                            shading="nearest", cmap="viridis", vmin=-6, vmax=0)
-        fig.colorbar(im, ax=ax, label="log10 |harmonic| / largest (tip of the most deflected blade)")
+        fig.colorbar(im, ax=ax, label="log10 |harmonic k| / largest")
         ax.set_xlabel("spin speed Ω / Ω_ref")
         ax.set_ylabel("harmonic k of Ω")
-        ax.set_title("Harmonic content of the HB orbits (a branch that folds is drawn where its points fall)")
+        ax.set_title("Harmonic content of the HB orbits: tip of the most deflected blade, rotating frame\n(a branch "
+                     "that folds is drawn where its points fall)", fontsize=10)
         return fig
 
     def save(self, out: str | Path, stem: str = "interaction_map") -> dict:

@@ -20,8 +20,11 @@ Q_k = Z_k^-1 (F_k + P^T f_k). Nothing is approximated beyond the truncation at H
 
 **Jacobian (exact).** dR/dY = I - L (P_dft [J_i E_i + w Jv_i dE_i]), J_i = P (dF_nl/dq) P^T and
 Jv_i = P (dF_nl/dq') P^T at sample i: the AFT of the kernel's analytic Jacobians (tested against finite
-differences). The forces and Jacobians at the m samples come from one kernel call (``rr_batch_eval``,
-``kernel/rr_batch.c``), each sample with its own frame angle.
+differences). The forces and the projected Jacobians at the m samples come from one kernel call
+(``rr_batch_reduced``, ``kernel/rr_batch.c``: assembled blade by blade in the contact coordinates from the laws'
+slopes, never as a full n x n Jacobian), each sample with its own frame angle; the AFT of the sampled Jacobian
+goes through the samples' discrete harmonics k = 0..2H (``rr_batch_aft_assemble``: the product-to-sum identities
+give the same sums at (2H+1) m r^2 instead of (2H+1)^2 m r^2 operations).
 """
 
 from __future__ import annotations

@@ -6,13 +6,14 @@ Jacobians along the orbit (T-periodic), C = D + G(Omega), K = K(Omega).
 
 **Monodromy (primary).** The first-order form z' = (A0 + dA(t)) z, A0 the linear part and
 dA(t) = B [J(t), Jv(t)]-rows of rank r (the contact coordinates of :mod:`.problem`: dA = B Cr(t),
-B = [0; M^-1 P^T], Cr = [Jp P, Jvp P]), is integrated over one period by Strang splitting on a grid of
-``substeps`` x m steps: z <- e^{A0 h/2} e^{dA h} e^{A0 h/2} z, with e^{A0 h} exact (A0's eigen-decomposition,
-diagonal in its modal coordinates) and e^{dA h} = I + h B phi1(h Cr B) Cr exact (rank r; phi1(x) = (e^x - 1)/x).
-The splitting's error is O(h^2) in the multipliers; the Jacobians at the fine grid come from the orbit's
-Fourier series through the kernel (``rr_batch_eval``). Why primary: it needs no sorting of spurious
-exponents, its cost grows with the grid, not with (2n(2H+1))^3, and it is a time integration of the same
-orbit, independent of the balance's own Jacobian.
+B = [0; M^-1 P^T], Cr = [Jp P, Jvp P]), is integrated over one period by Strang splitting on a grid of steps
+(default m / 2, at least 64): z <- e^{A0 h/2} e^{dA h} e^{A0 h/2} z, with e^{A0 h} exact (A0's real modal form:
+2 x 2 rotation-scalings) and e^{dA h} = I + h B phi1(h Cr B) Cr exact (rank r; phi1(x) = (e^x - 1)/x), the
+Jacobian averaged over 4 samples of each step (the 2D law switches inside steps). The product runs in C
+(``rr_batch_monodromy``); the Jacobians come from the orbit's Fourier series through the kernel
+(``rr_batch_reduced``). An orbit that touches at no sample has the contact-free spectrum's multipliers. Why
+primary: it needs no sorting of spurious exponents, its cost grows with the grid, not with (2n(2H+1))^3, and
+it is a time integration of the same orbit, independent of the balance's own Jacobian.
 
 **Hill's method (check).** With x = e^{lambda t} p(t), p on the HB basis (coefficients (2H+1) x n, derivative
 operator N = w nabla (x) I):

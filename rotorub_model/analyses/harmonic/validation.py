@@ -423,7 +423,7 @@ class Validation:
             ax.semilogy([r["H"] for r in rows], [max(abs(r["tip"]), 1e-12) for r in rows], "o-", label=f"{lab}: tip")
             ax.semilogy([r["H"] for r in rows], [max(abs(r["force"]), 1e-12) for r in rows], "x--",
                         label=f"{lab}: force")
-        ax.axhline(1e-2, color="k", lw=0.8, ls=":")
+        ax.axhline(1e-2, color="k", lw=0.8, ls=":", label="1 %")
         ax.set_xlabel("harmonics H")
         ax.set_ylabel(f"relative difference to H = {d['forced_3d'][0]['reference_H']}")
         ax.set_title("3D forced: convergence in H (self)")
@@ -439,6 +439,8 @@ class Validation:
                     ax.loglog(xi, yi, "o", color=f"C{i}", mfc=f"C{i}" if t["kind"] == "periodic" else "none")
         ax.plot([], [], "o", color="0.4", mfc="none", label="open: run still settling at 60 s")
         ax.minorticks_off()
+        ax.set_xticks([0.1, 0.2, 0.3, 0.4])
+        ax.set_xticklabels(["0.1", "0.2", "0.3", "0.4"])
         ax.set_xlabel("transient time step dt [ms] (T/64, T/128, T/256)")
         ax.set_ylabel("last revolution - HB(H=40), / range")
         ax.set_title("Transients converge to the HB orbit as dt^2")
