@@ -5,12 +5,23 @@ Panels: blade-tip amplitude; largest contact force; the casing's incursion (HB: 
 penetration) and, with the liner, the worn depth of the transients with its lobe count. HB branch: solid
 where stable, dashed where unstable (Floquet multipliers, :mod:`.stability`), folds and changes of stability
 marked. Transients: a filled dot where the run settled on a periodic orbit, a ring for a subharmonic, a cross
-(at the top of the panel) where it did not settle on a periodic orbit (quasi-periodic or chaotic), a red
-triangle where it diverged; such runs report no amplitude (the map marks them instead of pretending).
+(at the top of the panel) where it did not settle on a periodic orbit (still settling, quasi-periodic or
+chaotic), a red triangle where it diverged; such runs report no amplitude (the map marks them instead of
+pretending).
+
+Agreement: at each transient speed the HB orbit is solved at that very speed, with its multipliers, and the pair
+gets a verdict with its reason (both periodic within 1 %; the transient not settled for the HB's multiplier; another
+attractor; a periodic transient where the HB orbit is unstable; no stable orbit for either); a disagreement is
+marked on the map (a red "≠") and listed in the summary's ``disagreements``.
+
+Branch: followed in segments (:func:`follow_segments`): a blade resonance against the penalty contact hardens
+without end, and a segment that climbs it past ``contact.max_penetration`` of tip amplitude is cut there, the
+next starting past the furthest speed it reached.
 
 Crossings: the rotating-frame frequencies of the model without contact (the blades' and the casing ring's, the
-ring seen in the rotating frame as the model holds it) against k Omega for the forced harmonics k; a vertical
-line where they meet (k Omega = omega_mode(Omega)).
+ring seen in the rotating frame as the model holds it) against k Omega for the forced harmonics k and their
+doubles; a dotted line where they meet (k Omega = omega_mode(Omega)), numbered above the top panel in staggered
+rows and listed under the figure (the blades of a bladed disk share frequencies: one line with a count).
 """
 
 from __future__ import annotations
