@@ -43,10 +43,10 @@ from ...structure.params import to_dict
 from ..linear import first_order
 from ..sweeps import run_tasks
 from .continuation import HBBranch, HBPoint, continue_hb
-from .orbit import OrbitView, profile_lobes, tip_deflection
+from .orbit import OrbitView, measures_at_phases, profile_lobes, tip_deflection
 from .problem import HBProblem
 from .surface import CasingForcing
-from .transients import KINDS, SETTLE_TOL, forced_transient
+from .transients import KINDS, SAMPLES_PER_REV, SETTLE_TOL, forced_transient
 
 
 def mode_crossings(model: Model, speeds: np.ndarray, harmonics: tuple[int, ...], groups=("blades", "casing"),
@@ -327,10 +327,13 @@ def _agreement(problem: HBProblem, branch: HBBranch, tr: dict, omega_ref: float,
         row.update(hb_tip_m=p.measures.tip_amplitude, hb_disk_m=p.measures.disk_amplitude, hb_stable=fl.stable,
                    hb_largest_multiplier=fl.largest, hb_kind=fl.kind())
         if kind == "periodic" and fl.stable:
-            row["tip_relative_difference"] = (row["transient_tip_m"] - p.measures.tip_amplitude) / max(
-                p.measures.tip_amplitude, floor)
-            row["disk_relative_difference"] = (row["transient_disk_m"] - p.measures.disk_amplitude) / max(
-                p.measures.disk_amplitude, floor)
+            # like with like: the HB read on the transient's own recorded phases (64 a revolution)
+            same = measures_at_phases(problem, p.Y, om, om, SAMPLES_PER_REV)
+            row.update(hb_tip_same_phases_m=same.tip_amplitude, hb_disk_same_phases_m=same.disk_amplitude)
+            row["tip_relative_difference"] = (row["transient_tip_m"] - same.tip_amplitude) / max(
+                same.tip_amplitude, floor)
+            row["disk_relative_difference"] = (row["transient_disk_m"] - same.disk_amplitude) / max(
+                same.disk_amplitude, floor)
             row["relative_difference"] = max(abs(row["tip_relative_difference"]), abs(row["disk_relative_difference"]))
             if row["relative_difference"] <= 0.01:
                 row.update(verdict="agree", why="both periodic, amplitudes within 1 %")
