@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import ParameterError
-from .problem import HBProblem
+from .problem import HBProblem, frequency_derivative
 from .roots import regula_falsi
 from .stability import DEFAULT_SUBSTEPS, Floquet, monodromy_multipliers
 
@@ -72,43 +72,64 @@ class HBBranch:
 
 
 class _Tracer:
+    """The bordered system of one branch. Forced orbits: unknowns (Y, p), w = Omega. Autonomous orbits
+    (``autonomous``): unknowns (Y, w, p), w the orbit's own frequency, with the phase condition (:func:`phase_row`)
+    as the extra equation."""
+
     def __init__(self, problem: HBProblem, parameter: str, start: float, stop: float, fixed: float,
-                 y_scale: float):
+                 y_scale: float, autonomous: bool = False, w_scale: float = 1.0, phase: int | None = None):
         self.pb, self.par = problem, parameter
         self.p0, self.ps = start, abs(stop - start)
         self.fixed = fixed
         self.ys = y_scale
         self.N = problem.N
+        self.autonomous = autonomous
+        self.ws = w_scale
+        self.phase = phase
 
-    def args(self, p: float) -> tuple[float, float, float]:
-        """(omega, w, g0) at parameter value p."""
+    def args(self, p: float, w: float | None = None) -> tuple[float, float, float]:
+        """(omega, w, g0) at parameter value p (and frequency w of an autonomous orbit)."""
         if self.par == "omega":
-            return p, p, self.fixed
-        return self.fixed, self.fixed, p
+            return p, (p if w is None else w), self.fixed
+        return self.fixed, (self.fixed if w is None else w), p
 
     def unpack(self, z: np.ndarray) -> tuple[np.ndarray, float]:
-        return z[:-1] * self.ys, self.p0 + z[-1] * self.ps
+        return z[: self.N] * self.ys, self.p0 + z[-1] * self.ps
 
-    def pack(self, Y: np.ndarray, p: float) -> np.ndarray:
-        return np.concatenate([Y / self.ys, [(p - self.p0) / self.ps]])
+    def frequency(self, z: np.ndarray) -> float | None:
+        return float(z[self.N] * self.ws) if self.autonomous else None
+
+    def pack(self, Y: np.ndarray, p: float, w: float | None = None) -> np.ndarray:
+        mid = [w / self.ws] if self.autonomous else []
+        return np.concatenate([Y / self.ys, mid, [(p - self.p0) / self.ps]])
 
     def blocks(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """R / y_s, dR/dz (N x N+1)."""
+        """R / y_s (with the phase condition), dR/dz."""
         Y, p = self.unpack(z)
-        om, w, g0 = self.args(p)
+        w = self.frequency(z)
+        om, w, g0 = self.args(p, w)
         self.pb.set_clearance(g0)
         ev = self.pb.evaluate(Y, om, w)
         # dR/dp by a forward difference: R is smooth in Omega (the receptances, the imbalance) and affine in g0
         # where the contact set does not change; 1e-7 of p keeps its error near 1e-7 relative, below what the
         # predictor needs (the corrector uses the exact dR/dY)
         hp = 1e-7 * max(abs(p), 1e-3 if self.par == "g0" else 1.0)
-        o2, w2, g2 = self.args(p + hp)
+        o2, w2, g2 = self.args(p + hp, None if not self.autonomous else w)
         self.pb.set_clearance(g2)
         Rp = self.pb.evaluate(Y, o2, w2, jacobian=False).R
         self.pb.set_clearance(g0)
         dRdp = (Rp - ev.R) / hp * self.ps / self.ys
-        A = np.hstack([ev.J, dRdp[:, None]])  # dR/dY y_s / y_s = J
-        return ev.R / self.ys, A, ev.f_hat
+        if not self.autonomous:
+            A = np.hstack([ev.J, dRdp[:, None]])  # dR/dY y_s / y_s = J
+            return ev.R / self.ys, A, ev.f_hat
+        dRdw = frequency_derivative(self.pb, Y, om, w) * self.ws / self.ys
+        A = np.zeros((self.N + 1, self.N + 2))
+        A[: self.N, : self.N] = ev.J
+        A[: self.N, self.N] = dRdw
+        A[: self.N, -1] = dRdp
+        A[self.N, self.phase] = 1.0
+        R = np.concatenate([ev.R / self.ys, [z[self.phase]]])
+        return R, A, ev.f_hat
 
     def tangent(self, A: np.ndarray, previous: np.ndarray | None, direction: float) -> np.ndarray:
         """The null vector of A (N x N+1): one bordered solve with the previous tangent (an SVD at the start)."""
@@ -147,40 +168,74 @@ class _Tracer:
                 return (z, A, it) if np.linalg.norm(R) <= 1e3 * tol else (None, None, it)
         return None, None, max_iter
 
-    def point(self, z: np.ndarray, stability: bool, substeps: int, its: int = 0) -> HBPoint:
+    def point(self, z: np.ndarray, stability: bool, substeps: int | None, its: int = 0) -> HBPoint:
         Y, p = self.unpack(z)
-        om, w, g0 = self.args(p)
+        om, w, g0 = self.args(p, self.frequency(z))
         self.pb.set_clearance(g0)
-        fl = monodromy_multipliers(self.pb, Y, om, w, substeps) if stability else None
+        fl = monodromy_multipliers(self.pb, Y, om, w, substeps, autonomous=self.autonomous) if stability else None
         return HBPoint(om, g0, w, Y, fl, its)
 
 
 def continue_hb(problem: HBProblem, parameter: str, start: float, stop: float, fixed: float,
                 Y0: np.ndarray | None = None, h_max: float = 0.05, max_points: int = 2000, stability: bool = True,
-                substeps: int = DEFAULT_SUBSTEPS, progress=None) -> HBBranch:
-    """Follow the forced HB orbit from ``parameter = start`` to ``stop`` (``omega`` [rad/s] at g0 = ``fixed``, or
-    ``g0`` [m] at Omega = ``fixed``). ``h_max``: the largest step as a fraction of the range (and of y_s)."""
+                substeps: float | None = DEFAULT_SUBSTEPS, progress=None, autonomous: bool = False,
+                w0: float | None = None, start_tangent: tuple[np.ndarray, float, float] | None = None,
+                y_scale: float | None = None, halt=None) -> HBBranch:
+    """Follow the HB orbit from ``parameter = start`` to ``stop`` (``omega`` [rad/s] at g0 = ``fixed``, or
+    ``g0`` [m] at Omega = ``fixed``). ``h_max``: the largest step as a fraction of the range (and of y_s).
+
+    Forced orbits (default): w = Omega. ``autonomous``: the orbit's frequency is an unknown (start ``w0``) and a
+    phase condition fixes its time origin (:func:`.autonomous.phase_index`: the sine of harmonic 1 of the
+    coordinate that moves most vanishes); ``start_tangent`` (dY, dw, dp) starts the branch at (Y0, w0) as it is
+    (a Hopf point: the static solution, any w) along that direction, instead of a Newton solve there.
+    ``halt(point) -> str | None``: a reason to end the branch at this point (the map's bound on the amplitude)."""
     if parameter not in ("omega", "g0"):
         raise ParameterError(f"parameter: '{parameter}' unknown; accepted: omega, g0")
     if not (math.isfinite(start) and math.isfinite(stop)) or start == stop:
         raise ParameterError(f"start, stop: {start}, {stop}: a range of finite, distinct values is needed")
+    if autonomous and (Y0 is None or w0 is None):
+        raise ParameterError("autonomous: needs a start Y0 and its frequency w0 (an orbit, or a Hopf point's "
+                             "static solution with start_tangent)")
     pb = problem
     om, w, g0 = (start, start, fixed) if parameter == "omega" else (fixed, fixed, start)
+    if autonomous:
+        w = float(w0)
     pb.set_clearance(g0)
+    from .autonomous import newton_autonomous, phase_index
     from .problem import newton
 
-    first = newton(pb, pb.linear_start(om, w) if Y0 is None else Y0, om, w)
-    if not first.converged:
-        return HBBranch(parameter, [], [], False, f"no HB solution at the start (|R| = {first.residual:.2e})")
+    phase = None
+    if autonomous:
+        if start_tangent is not None:
+            phase = phase_index(pb, start_tangent[0])
+            first_Y, first_it = np.asarray(Y0, dtype=float), 0
+        else:
+            phase = phase_index(pb, Y0)
+            res = newton_autonomous(pb, Y0, w, om, phase=phase)
+            if not res.converged:
+                return HBBranch(parameter, [], [], False, f"no autonomous HB solution at the start (|R| = "
+                                                          f"{res.residual:.2e})")
+            first_Y, w, first_it = res.Y, res.w, res.iterations
+    else:
+        first = newton(pb, pb.linear_start(om, w) if Y0 is None else Y0, om, w)
+        if not first.converged:
+            return HBBranch(parameter, [], [], False, f"no HB solution at the start (|R| = {first.residual:.2e})")
+        first_Y, first_it = first.Y, first.iterations
     # the length scale of the response: the clearance (a rub's amplitudes are of its order), or the no-contact
     # response where that is larger; with a smaller scale the steps crawl through a resonance peak
-    y_scale = max(float(np.abs(pb.linear_start(om, w)).max()), 2 * abs(g0), 1e-6)
-    tr = _Tracer(pb, parameter, start, stop, fixed, y_scale)
+    if y_scale is None:
+        y_scale = max(float(np.abs(pb.linear_start(om, w)).max()), 2 * abs(g0), 1e-6)
+    tr = _Tracer(pb, parameter, start, stop, fixed, y_scale, autonomous, abs(w) if autonomous else 1.0, phase)
     direction = float(np.sign(stop - start))
-    z = tr.pack(first.Y, start)
+    z = tr.pack(first_Y, start, w if autonomous else None)
     _, A, _ = tr.blocks(z)
-    t = tr.tangent(A, None, direction)
-    pts = [tr.point(z, stability, substeps, first.iterations)]
+    if start_tangent is not None:
+        dY, dw, dp = start_tangent
+        t = tr.pack(np.asarray(dY) + 0.0, tr.p0 + dp, dw) - tr.pack(np.zeros(pb.N), tr.p0, 0.0)
+        t /= np.linalg.norm(t)
+    else:
+        t = tr.tangent(A, None, direction)
+    pts = [tr.point(z, stability and start_tangent is None, substeps, first_it)]
     specials: list[Special] = []
     h = 0.2 * h_max
     det_sign = _bordered_sign(A, t)
@@ -211,6 +266,11 @@ def continue_hb(problem: HBProblem, parameter: str, start: float, stop: float, f
         if progress is not None:
             progress(new)
         z, t, det_sign = z_new, t_new, sign_new
+        reason = halt(new) if halt is not None else None
+        if reason:
+            message = f"stopped at {parameter} = {tr.unpack(z)[1]:.6g}: {reason}"
+            complete = False
+            break
         if complete:
             break
         h = min(h * (1.5 if its <= 3 else 1.0 if its <= 5 else 0.5), h_max)

@@ -5,17 +5,29 @@ Panels: blade-tip amplitude; largest contact force; the casing's incursion (HB: 
 penetration) and, with the liner, the worn depth of the transients with its lobe count. HB branch: solid
 where stable, dashed where unstable (Floquet multipliers, :mod:`.stability`), folds and changes of stability
 marked. Transients: a filled dot where the run settled on a periodic orbit, a ring for a subharmonic, a cross
-(at the top of the panel) where it did not settle on a periodic orbit (quasi-periodic or chaotic), a red
-triangle where it diverged; such runs report no amplitude (the map marks them instead of pretending).
+(at the top of the panel) where it did not settle on a periodic orbit (still settling, quasi-periodic or
+chaotic), a red triangle where it diverged; such runs report no amplitude (the map marks them instead of
+pretending).
+
+Agreement: at each transient speed the HB orbit is solved at that very speed, with its multipliers, and the pair
+gets a verdict with its reason (both periodic within 1 %; the transient not settled for the HB's multiplier; another
+attractor; a periodic transient where the HB orbit is unstable; no stable orbit for either); a disagreement is
+marked on the map (a red "≠") and listed in the summary's ``disagreements``.
+
+Branch: followed in segments (:func:`follow_segments`): a blade resonance against the penalty contact hardens
+without end, and a segment that climbs it past ``contact.max_penetration`` of tip amplitude is cut there, the
+next starting past the furthest speed it reached.
 
 Crossings: the rotating-frame frequencies of the model without contact (the blades' and the casing ring's, the
-ring seen in the rotating frame as the model holds it) against k Omega for the forced harmonics k; a vertical
-line where they meet (k Omega = omega_mode(Omega)).
+ring seen in the rotating frame as the model holds it) against k Omega for the forced harmonics k and their
+doubles; a dotted line where they meet (k Omega = omega_mode(Omega)), numbered above the top panel in staggered
+rows and listed under the figure (the blades of a bladed disk share frequencies: one line with a count).
 """
 
 from __future__ import annotations
 
 import math
+import textwrap
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,11 +42,11 @@ from ...structure.model import Model
 from ...structure.params import to_dict
 from ..linear import first_order
 from ..sweeps import run_tasks
-from .continuation import HBBranch, continue_hb
-from .orbit import OrbitView, profile_lobes
+from .continuation import HBBranch, HBPoint, continue_hb
+from .orbit import OrbitView, measures_at_phases, profile_lobes, tip_deflection
 from .problem import HBProblem
 from .surface import CasingForcing
-from .transients import KINDS, forced_transient
+from .transients import KINDS, SAMPLES_PER_REV, SETTLE_TOL, forced_transient
 
 
 def mode_crossings(model: Model, speeds: np.ndarray, harmonics: tuple[int, ...], groups=("blades", "casing"),
@@ -68,7 +80,28 @@ def mode_crossings(model: Model, speeds: np.ndarray, harmonics: tuple[int, ...],
                 om = grid[i] + (grid[i + 1] - grid[i]) * a / (a - b)
                 out.append({"k": int(k), "mode": j + 1, "group": lab, "omega_rad_s": float(om),
                             "frequency_rad_s": float(k * om)})
-    return out
+    return merge_crossings(out, float(np.ptp(grid)) * 2e-3)
+
+
+def merge_crossings(crossings: list[dict], tol: float) -> list[dict]:
+    """One entry per (harmonic, group) and speed within ``tol`` [rad/s]: the blades of a bladed disk share their
+    modes' frequencies (8 of the 10 first blade modes cross 2 Omega at one speed), and eight labelled lines there
+    say nothing more than one with a count."""
+    out: list[dict] = []
+    for c in sorted(crossings, key=lambda c: (c["k"], c["group"], c["omega_rad_s"])):
+        last = out[-1] if out else None
+        if last and last["k"] == c["k"] and last["group"] == c["group"] and \
+                abs(c["omega_rad_s"] - last["omega_rad_s"]) <= tol:
+            last["modes"].append(c["mode"])
+            continue
+        out.append({**c, "modes": [c["mode"]]})
+    return sorted(out, key=lambda c: c["omega_rad_s"])
+
+
+def crossing_label(c: dict) -> str:
+    who = "blade" if c["group"] == "blades" else "casing"
+    n = len(c.get("modes", [c["mode"]]))
+    return f"{c['k']}Ω = {who} mode {c['mode']}" + (f" (x{n})" if n > 1 else "")
 
 
 @dataclass
@@ -83,6 +116,8 @@ class InteractionMap:
     transients: dict[str, np.ndarray]  # per transient speed: speed, kind, tip, force, wear_depth, wear_lobes
     crossings: list[dict]
     timings: dict[str, float] = field(default_factory=dict)
+    t_end: float = 60.0
+    refine: int = 1
 
     # ------------------------------------------------------------------ numbers
     def agreement(self) -> list[dict]:
@@ -92,25 +127,33 @@ class InteractionMap:
         move)."""
         return list(self.transients.get("agreement", []))
 
+    def disagreements(self) -> list[dict]:
+        return [r for r in self.agreement() if r.get("verdict") == "disagree"]
+
     def summary(self) -> dict:
         b = self.branch
         ag = self.agreement()
         rel = [abs(r["relative_difference"]) for r in ag if "relative_difference" in r]
         kinds = [KINDS[int(k)] for k in self.transients.get("kind", [])]
-        verdict = (f"{self.formulation}, g0 = {self.g0 * 1e3:.3g} mm: HB branch of {len(b.points)} orbits "
-                   f"({b.message}); "
-                   f"{int(np.sum(~self.hb['stable']))} unstable; {len(b.specials)} special points; transients at "
-                   f"{len(kinds)} speeds: {sum(k == 'periodic' for k in kinds)} periodic, "
-                   f"{sum(k not in ('periodic', 'settling') for k in kinds)} marked not periodic; "
-                   + (f"HB-transient tip amplitude within {100 * max(rel):.2g} % where both are periodic"
-                      if rel else "no speed where both are periodic"))
+        dis = self.disagreements()
+        verdict = (f"{self.formulation}, g0 = {self.g0 * 1e3:.3g} mm, casing {_forcing_text(self.forcing)}: HB "
+                   f"branch of {len(b.points)} orbits ({b.message}), {int(np.sum(~self.hb['stable']))} unstable, "
+                   f"{len(b.specials)} special points; transients ({self.t_end:g} s) at {len(kinds)} speeds: "
+                   f"{sum(k == 'periodic' for k in kinds)} periodic, {sum(k == 'settling' for k in kinds)} not "
+                   f"settled, {sum(k not in ('periodic', 'settling') for k in kinds)} not periodic; "
+                   + (f"HB-transient amplitudes within {100 * max(rel):.2g} % where both are periodic; "
+                      if rel else "no speed where both are periodic; ")
+                   + (f"HB and transient DISAGREE at {len(dis)} speed(s): "
+                      + "; ".join(f"{r['speed']:.3g}: {r['why']}" for r in dis) if dis else "no disagreement"))
         return {"formulation": self.formulation, "g0_m": self.g0, "forcing": self.forcing.summary(),
                 "harmonics": self.harmonics, "omega_ref_rad_s": self.omega_ref, "branch_message": b.message,
                 "points": len(b.points), "specials": [s.summary() for s in b.specials],
                 "hb": {k: v.tolist() for k, v in self.hb.items() if k != "harmonics"},
                 "transients": {k: (v.tolist() if k != "kind" else [KINDS[int(x)] for x in v])
                                for k, v in self.transients.items() if k != "agreement"},
-                "crossings": self.crossings, "agreement": ag, "timings_s": self.timings, "verdict": verdict}
+                "transient_t_end_s": self.t_end, "transient_refine": self.refine,
+                "crossings": self.crossings, "agreement": ag, "disagreements": dis, "timings_s": self.timings,
+                "verdict": verdict}
 
     # ------------------------------------------------------------------ figures
     def figure(self):
@@ -122,7 +165,11 @@ class InteractionMap:
         for ax, key, scale, label in ((axes[0], "tip_amplitude", 1e3, "blade-tip amplitude [mm]"),
                                       (axes[1], "max_force", 1.0, "largest contact force [N]"),
                                       (axes[2], "incursion", 1e3, "incursion / wear depth [mm]")):
-            _draw_branch(ax, s, self.hb[key] * scale, st, "HB" + (" incursion" if key == "incursion" else ""))
+            seg = self.hb.get("segment", np.zeros(s.size, dtype=int))
+            for k in np.unique(seg):  # a branch cut where it left the model's range is drawn in its pieces
+                on = seg == k
+                _draw_branch(ax, s[on], self.hb[key][on] * scale, st[on],
+                             "HB" + (" incursion" if key == "incursion" else ""))
             ax.set_ylabel(label)
             ax.grid(alpha=0.3)
         for sp in self.branch.specials:
@@ -152,19 +199,42 @@ class InteractionMap:
                 axes[2].plot(tr["speed"], tr["wear_depth"] * 1e3, "v", color="C2", label="transient wear depth")
                 for x, y, lob in zip(tr["speed"], tr["wear_depth"] * 1e3, tr["wear_lobes"]):
                     if y > 0:
-                        axes[2].annotate(f"{int(lob)}", (x, y), textcoords="offset points", xytext=(0, 5),
-                                         fontsize=7, ha="center", color="C2")
-        for c in self.crossings:
+                        axes[2].annotate(f"{int(lob)} lobes" if lob else "even", (x, y), textcoords="offset points",
+                                         xytext=(0, 5), fontsize=7, ha="center", color="C2")
+        # where the HB and the transient disagree (the agreement's verdicts): a red mark at the panel's foot
+        dis = self.disagreements()
+        for r in dis:
+            for ax in axes[:2]:
+                ax.annotate("≠", (r["speed"], 0.02), xycoords=("data", "axes fraction"), color="red", fontsize=11,
+                            ha="center", va="bottom", fontweight="bold")
+        if dis:
+            axes[0].plot([], [], ls="none", marker="$≠$", color="red", ms=9,
+                         label="HB and transient disagree (why: the JSON's 'disagreements')")
+        # mode crossings: dotted lines, numbered above the top panel in staggered rows, listed under the figure
+        lo, hi = axes[0].get_xlim()
+        rows_x: list[float] = []
+        notes = []
+        for i, c in enumerate(self.crossings, 1):
             x = c["omega_rad_s"] / self.omega_ref
             for ax in axes:
-                ax.axvline(x, color="0.6" if c["group"] == "blades" else "C4", lw=0.7, ls=":")
-            axes[0].annotate(f"{c['k']}Ω={c['group'][:-1] if c['group'] == 'blades' else 'ring'} {c['mode']}",
-                             (x, 1.0), xycoords=("data", "axes fraction"), rotation=90, fontsize=6, va="top",
-                             ha="right", color="0.4")
+                ax.axvline(x, color="0.55" if c["group"] == "blades" else "C4", lw=0.7, ls=":")
+            row = next((k for k, last in enumerate(rows_x) if x - last > 0.035 * (hi - lo)), len(rows_x))
+            if row == len(rows_x):
+                rows_x.append(x)
+            rows_x[row] = x
+            axes[0].annotate(str(i), (x, 1.01 + 0.055 * row), xycoords=("data", "axes fraction"), fontsize=7,
+                             ha="center", va="bottom", color="0.3" if c["group"] == "blades" else "C4",
+                             annotation_clip=False)
+            notes.append(f"{i}: {crossing_label(c)} at {x:.3g}")
         axes[-1].set_xlabel("spin speed Ω / Ω_ref")
         f = self.forcing
         axes[0].set_title(f"Interaction map, {self.formulation}, g0 = {self.g0 * 1e3:.3g} mm, casing "
-                          f"{_forcing_text(f)}, H = {self.harmonics}")
+                          f"{_forcing_text(f)}, H = {self.harmonics}", pad=12 + 9 * len(rows_x))
+        if notes:
+            text = "Mode crossings k Ω = ω (rotating frame, no contact; grey: blades, purple: casing): " + \
+                   "; ".join(notes)
+            axes[-1].annotate(textwrap.fill(text, 125), (0.0, -0.3), xycoords="axes fraction", fontsize=7,
+                              va="top", ha="left", annotation_clip=False)
         for ax in axes:
             legend_outside(ax)
         return fig
@@ -178,10 +248,11 @@ class InteractionMap:
         order = np.argsort(s)
         im = ax.pcolormesh(s[order], np.arange(Hc.shape[1]), np.log10(np.maximum(rel[order].T, 1e-8)),
                            shading="nearest", cmap="viridis", vmin=-6, vmax=0)
-        fig.colorbar(im, ax=ax, label="log10 |harmonic| / largest (tip of the most deflected blade)")
+        fig.colorbar(im, ax=ax, label="log10 |harmonic k| / largest")
         ax.set_xlabel("spin speed Ω / Ω_ref")
         ax.set_ylabel("harmonic k of Ω")
-        ax.set_title("Harmonic content of the HB orbits (a branch that folds is drawn where its points fall)")
+        ax.set_title("Harmonic content of the HB orbits: tip of the most deflected blade, rotating frame\n(a branch "
+                     "that folds is drawn where its points fall)", fontsize=10)
         return fig
 
     def save(self, out: str | Path, stem: str = "interaction_map") -> dict:
@@ -207,16 +278,17 @@ def _forcing_text(f: CasingForcing) -> str:
 
 
 def _draw_branch(ax, s, y, stable, label):
-    """Stable parts solid, unstable dashed, in the branch's own order (it may fold back)."""
-    first = {True: True, False: True}
+    """Stable parts solid, unstable dashed, in the branch's own order (it may fold back); each label once."""
+    have = set(ax.get_legend_handles_labels()[1])
     i0 = 0
     for i in range(1, len(s) + 1):
         if i == len(s) or stable[i] != stable[i0]:
             seg = slice(max(i0 - 1, 0), i)
             st = bool(stable[i0])
+            lab = f"{label} stable" if st else f"{label} unstable"
             ax.plot(s[seg], y[seg], "-" if st else "--", color="C0" if st else "C1", lw=1.4,
-                    label=(f"{label} stable" if st else f"{label} unstable") if first[st] else None)
-            first[st] = False
+                    label=None if lab in have else lab)
+            have.add(lab)
             i0 = i
 
 
@@ -230,32 +302,57 @@ def _stable_values_at(s, y, stable, x) -> list[float]:
     return out
 
 
-def _agreement(problem: HBProblem, branch: HBBranch, tr: dict, omega_ref: float, g0: float) -> list[dict]:
-    from .problem import newton
-    from .stability import monodromy_multipliers
+def _agreement(problem: HBProblem, branch: HBBranch, tr: dict, omega_ref: float, g0: float,
+               t_end: float) -> list[dict]:
+    """Each transient speed against the HB orbit solved at that very speed (warm-started from the nearest point of
+    the branch, stable or not, with its own Floquet multipliers), and a verdict: where the two disagree, why."""
+    from .sweep import hb_point
 
     rows = []
-    pts = [p for p in branch.points if p.stable]
     floor = 1e-3 * abs(g0)
+    problem.set_clearance(g0)
     for i, s in enumerate(tr["speed"]):
         kind = KINDS[int(tr["kind"][i])]
-        row = {"speed": float(s), "transient": kind, "transient_tip_m": float(tr["tip_amplitude"][i]),
-               "transient_disk_m": float(tr["disk_amplitude"][i])}
-        if kind == "periodic" and pts:
-            om = s * omega_ref
-            near = min(pts, key=lambda p: abs(p.omega - om))
-            problem.set_clearance(g0)
-            res = newton(problem, near.Y, om, om)
-            if res.converged:
-                m = OrbitView(problem, res.Y, om, om).measures()
-                fl = monodromy_multipliers(problem, res.Y, om, om)
-                row.update(hb_tip_m=m.tip_amplitude, hb_disk_m=m.disk_amplitude, hb_stable=fl.stable,
-                           tip_relative_difference=(row["transient_tip_m"] - m.tip_amplitude) / max(m.tip_amplitude,
-                                                                                                    floor),
-                           disk_relative_difference=(row["transient_disk_m"] - m.disk_amplitude) / max(
-                               m.disk_amplitude, floor))
-                row["relative_difference"] = max(abs(row["tip_relative_difference"]),
-                                                 abs(row["disk_relative_difference"]))
+        om = float(s * omega_ref)
+        row = {"speed": float(s), "transient": kind, "transient_remaining": float(tr["remaining"][i])}
+        if kind not in ("divergent",):
+            row.update(transient_tip_m=float(tr["tip_amplitude"][i]), transient_disk_m=float(tr["disk_amplitude"][i]))
+        near = min(branch.points, key=lambda p: abs(p.omega - om)) if branch.points else None
+        p = hb_point(problem, om, None if near is None else near.Y, stability=True, measure_samples=1024)
+        if not p.converged:
+            row.update(hb="no solution", verdict="disagree", why="the HB found no orbit at this speed")
+            rows.append(row)
+            continue
+        fl = p.floquet
+        row.update(hb_tip_m=p.measures.tip_amplitude, hb_disk_m=p.measures.disk_amplitude, hb_stable=fl.stable,
+                   hb_largest_multiplier=fl.largest, hb_kind=fl.kind())
+        if kind == "periodic" and fl.stable:
+            # like with like: the HB read on the transient's own recorded phases (64 a revolution)
+            same = measures_at_phases(problem, p.Y, om, om, SAMPLES_PER_REV)
+            row.update(hb_tip_same_phases_m=same.tip_amplitude, hb_disk_same_phases_m=same.disk_amplitude)
+            row["tip_relative_difference"] = (row["transient_tip_m"] - same.tip_amplitude) / max(
+                same.tip_amplitude, floor)
+            row["disk_relative_difference"] = (row["transient_disk_m"] - same.disk_amplitude) / max(
+                same.disk_amplitude, floor)
+            row["relative_difference"] = max(abs(row["tip_relative_difference"]), abs(row["disk_relative_difference"]))
+            if row["relative_difference"] <= 0.01:
+                row.update(verdict="agree", why="both periodic, amplitudes within 1 %")
+            else:
+                row.update(verdict="disagree", why=f"both periodic, amplitudes {100 * row['relative_difference']:.2g} "
+                           "% apart: the transient's step (T/64) errs on the fast blade mode (dt^2: halve it; "
+                           "docs/THEORY.md section 8)")
+        elif fl.stable and kind == "settling":
+            revs = math.log(SETTLE_TOL) / math.log(max(fl.largest, 1e-12)) if fl.largest < 1 else math.inf
+            row.update(verdict="disagree", why=f"the transient had not settled in {t_end:g} s (largest multiplier "
+                       f"{fl.largest:.4f}: ~{revs:.0f} revolutions to 2e-3); the HB needs no settling")
+        elif fl.stable:
+            row.update(verdict="disagree", why=f"the HB orbit is stable but the transient went {kind}: another "
+                       "attractor coexists at this speed (the transient's start decides)")
+        elif kind == "periodic":
+            row.update(verdict="disagree", why=f"the transient settled on a periodic orbit where this HB orbit is "
+                       f"unstable ({fl.kind()}): another branch holds it")
+        else:
+            row.update(verdict="agree", why=f"no stable orbit: HB unstable ({fl.kind()}), the transient {kind}")
         rows.append(row)
     return rows
 
@@ -282,12 +379,72 @@ def hb_measures(problem: HBProblem, branch: HBBranch, omega_ref: float) -> dict[
     return out
 
 
+def tip_cap(model: Model, problem: HBProblem, contact) -> callable:
+    """The bound a followed branch must stay within: the blade-tip amplitude (the sum of its harmonics' moduli,
+    an upper bound, from the orbit's coefficients: no sampling) at most ``contact.max_penetration`` (3 mm in the
+    reference), the depth at which the transients stop as diverged. A resonance of the blades against a penalty
+    contact hardens without end: the branch climbs its backbone to amplitudes the small-displacement model does
+    not hold (measured: 5 mm at 2 Omega = blade mode 3, g0 = 0.1 mm), and a continuation there never returns."""
+    cap = float(model.params.contact.max_penetration)
+
+    def halt(p) -> str | None:
+        problem.set_clearance(p.g0)
+        tip = tip_deflection(model, problem.full(p.Y, p.omega, p.w))  # (2H+1, blades) coefficients
+        amp = float(problem.basis.amplitudes(tip)[1:].sum(axis=0).max())
+        return None if amp <= cap else (f"blade-tip amplitude above contact.max_penetration = {cap * 1e3:.3g} mm "
+                                        "(beyond the model's range: the map restarts past this speed)")
+    return halt
+
+
+def follow_segments(problem: HBProblem, start: float, stop: float, g0: float, halt, max_points: int,
+                    progress=None, restart_step: float | None = None) -> tuple[HBBranch, np.ndarray]:
+    """Continuation in Omega from ``start`` to ``stop`` in segments: a segment ends at the range's end, at
+    ``max_points``, or where ``halt`` says; the next starts at the first speed past the furthest one reached
+    (steps of ``restart_step``, 0.5 % of the range by default) where Newton from the contact-free response finds
+    an orbit within the bound. Returns the points of all segments as one branch and each point's segment."""
+    from .sweep import hb_point
+
+    step = restart_step or 0.005 * (stop - start)
+    pts, specials, msgs, seg = [], [], [], []
+    Y0, s0 = None, start
+    while True:
+        br = continue_hb(problem, "omega", s0, stop, g0, Y0=Y0, max_points=max_points, progress=progress, halt=halt)
+        k = len(msgs)
+        pts += br.points
+        specials += br.specials
+        seg += [k] * len(br.points)
+        msgs.append(f"[{s0:.4g}, ...]: {br.message}")
+        if br.complete or not br.points:
+            break
+        reached = max(p.omega for p in br.points)
+        Y0 = None
+        s = reached + step
+        while s < stop:
+            problem.set_clearance(g0)
+            p = hb_point(problem, s, None, stability=False, measure_samples=0)
+            if p.converged:
+                if halt(HBPoint(s, g0, s, p.Y)) is None:
+                    Y0, s0 = p.Y, s
+                    break
+            s += step
+        if Y0 is None:
+            msgs.append(f"no orbit within the bound found past {reached:.4g} rad/s")
+            break
+    complete = bool(pts) and abs(max(p.omega for p in pts) - stop) <= 1e-9 * stop
+    return HBBranch("omega", pts, specials, complete, "; ".join(msgs)), np.array(seg, dtype=int)
+
+
 def run_interaction_map(model: Model, formulation: str = "2D", speed_range: tuple[float, float] = (2.5, 4.5),
                         g0: float | None = None, forcing: CasingForcing | None = None, harmonics: int = 10,
-                        n_transients: int = 9, t_end: float = 20.0, wear: bool = True, executor=None,
-                        progress: bool = True, out: str | Path | None = None) -> InteractionMap:
+                        n_transients: int = 9, t_end: float = 60.0, wear: bool = True, executor=None,
+                        progress: bool = True, out: str | Path | None = None, refine: int = 1,
+                        max_points: int = 400) -> InteractionMap:
     """HB continuation in the spin speed over ``speed_range`` (normalised) and transients at ``n_transients``
-    speeds through the executor (:func:`..sweeps.run_tasks`: process pool, "serial", or a Dask executor)."""
+    speeds through the executor (:func:`..sweeps.run_tasks`: process pool, "serial", or a Dask executor).
+    ``forcing`` defaults to an oval casing (2 lobes of 0.3 g0, widest at 0); ``refine`` divides the transients'
+    step (T/64): in 3D the fast blade mode needs 2 for the amplitudes to be within 1 % (docs/THEORY.md 8).
+    The branch is followed in segments (:func:`follow_segments`): one that climbs a resonance beyond the model's
+    range is cut there and the map restarts past the furthest speed it reached."""
     lo, hi = (float(v) for v in speed_range)
     smax = model.params.normalisation.speed_max
     if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi <= smax):
@@ -296,7 +453,7 @@ def run_interaction_map(model: Model, formulation: str = "2D", speed_range: tupl
     if n_transients < 0:
         raise ParameterError(f"n_transients: {n_transients} out of range; accepted [0, inf)")
     g0 = model.params.contact.g0 if g0 is None else float(g0)
-    forcing = forcing if forcing is not None else CasingForcing(offset=(0.3 * g0, 0.0))
+    forcing = forcing if forcing is not None else CasingForcing.lobe(2, 0.3 * g0)
     forcing.check(g0)
     wr = model.params.normalisation.omega_ref
     contact = make_contact(model, formulation, g0=g0)
@@ -308,10 +465,11 @@ def run_interaction_map(model: Model, formulation: str = "2D", speed_range: tupl
         bar = tqdm(desc=f"HB continuation {formulation}", unit="orbit", total=None)
     t0 = time.perf_counter()
     with threadpool_limits(limits=1):  # small dense algebra: BLAS threads only fight on a shared machine
-        branch = continue_hb(problem, "omega", lo * wr, hi * wr, g0,
-                             progress=(lambda p: bar.update(1)) if bar is not None else None)
+        branch, seg = follow_segments(problem, lo * wr, hi * wr, g0, tip_cap(model, problem, contact),
+                                      max_points, (lambda p: bar.update(1)) if bar is not None else None)
         t_hb = time.perf_counter() - t0
         hb = hb_measures(problem, branch, wr)
+        hb["segment"] = seg
     if bar is not None:
         bar.close()
     t1 = time.perf_counter()
@@ -321,10 +479,10 @@ def run_interaction_map(model: Model, formulation: str = "2D", speed_range: tupl
         pd = to_dict(model.params)
         payloads = [{"params": pd, "formulation": formulation, "omega": float(s * wr), "g0": g0,
                      "offset": list(forcing.offset), "lobes": {str(k): list(v) for k, v in forcing.lobes.items()},
-                     "t_end": float(t_end), "wears": False} for s in speeds]
+                     "t_end": float(t_end), "wears": False, "refine": int(refine)} for s in speeds]
         res = run_tasks(forced_transient, payloads, executor=executor, progress=progress, desc="transients")
         tr = {"speed": speeds, "kind": np.array([int(r["kind"]) for r in res]),
-              "spread": np.array([float(r["spread"]) for r in res])}
+              "remaining": np.array([float(r["remaining"]) for r in res])}
         for key in ("tip_amplitude", "max_force", "disk_amplitude", "penetration"):
             tr[key] = np.array([float(r[key]) if key in r and KINDS[int(r["kind"])] != "divergent" else math.nan
                                 for r in res])
@@ -338,10 +496,12 @@ def run_interaction_map(model: Model, formulation: str = "2D", speed_range: tupl
     t_tr = time.perf_counter() - t1
     if n_transients:
         with threadpool_limits(limits=1):
-            tr["agreement"] = _agreement(problem, branch, tr, wr, g0)
-    crossings = mode_crossings(model, np.array([lo, hi]) * wr, tuple(sorted({*forcing.lobe_counts, 1, 2, 3})))
+            tr["agreement"] = _agreement(problem, branch, tr, wr, g0, t_end)
+    # the forced harmonics and their doubles (a rub's force is rich in both): k n Omega = omega_mode
+    crossings = mode_crossings(model, np.array([lo, hi]) * wr,
+                               tuple(sorted({k * n for n in forcing.lobe_counts for k in (1, 2)})))
     result = InteractionMap(formulation, g0, forcing, harmonics, wr, branch, hb, tr, crossings,
-                            {"hb_continuation": t_hb, "transients": t_tr})
+                            {"hb_continuation": t_hb, "transients": t_tr}, t_end, refine)
     if out is not None:
         result.save(out)
     return result

@@ -20,8 +20,11 @@ Q_k = Z_k^-1 (F_k + P^T f_k). Nothing is approximated beyond the truncation at H
 
 **Jacobian (exact).** dR/dY = I - L (P_dft [J_i E_i + w Jv_i dE_i]), J_i = P (dF_nl/dq) P^T and
 Jv_i = P (dF_nl/dq') P^T at sample i: the AFT of the kernel's analytic Jacobians (tested against finite
-differences). The forces and Jacobians at the m samples come from one kernel call (``rr_batch_eval``,
-``kernel/rr_batch.c``), each sample with its own frame angle.
+differences). The forces and the projected Jacobians at the m samples come from one kernel call
+(``rr_batch_reduced``, ``kernel/rr_batch.c``: assembled blade by blade in the contact coordinates from the laws'
+slopes, never as a full n x n Jacobian), each sample with its own frame angle; the AFT of the sampled Jacobian
+goes through the samples' discrete harmonics k = 0..2H (``rr_batch_aft_assemble``: the product-to-sum identities
+give the same sums at (2H+1) m r^2 instead of (2H+1)^2 m r^2 operations).
 """
 
 from __future__ import annotations
@@ -52,6 +55,19 @@ def _lib():
         lib.rr_batch_eval.restype = ctypes.c_int
         lib.rr_batch_work_size.argtypes = [ctypes.c_int, ctypes.c_int]
         lib.rr_batch_work_size.restype = ctypes.c_int
+        ci = ctypes.c_int
+        lib.rr_batch_reduced_work_size.argtypes = [ci, ci, ci, ci]
+        lib.rr_batch_reduced_work_size.restype = ci
+        lib.rr_batch_reduced.argtypes = [ctypes.POINTER(kernel.RRContact), ci, dp, dp, ctypes.c_double, dp, ci, dp,
+                                         dp, dp, dp, dp]
+        lib.rr_batch_reduced.restype = ci
+        lib.rr_batch_laws.argtypes = [ctypes.POINTER(kernel.RRContact), ci, dp, dp, dp, dp]
+        lib.rr_batch_laws.restype = None
+        lib.rr_batch_aft_assemble.argtypes = [ci, ci, ci, dp, dp, dp, dp, ctypes.c_double, dp]
+        lib.rr_batch_aft_assemble.restype = None
+        lib.rr_batch_monodromy.argtypes = [ci, ci, dp, dp, dp, ci, ctypes.c_double, dp, ci, dp, dp, dp, dp, dp, dp,
+                                           dp, dp]
+        lib.rr_batch_monodromy.restype = ci
         _declared = True
     return lib
 
@@ -96,15 +112,69 @@ def check_truncation(problem: HBProblem, Y: np.ndarray) -> str | None:
     return msg
 
 
+class KernelContact:
+    """The rotor's contact force through the kernel, in the contact coordinates y = P q: the nonlinearity of the
+    balance (any object with ``P``, ``g0``, ``set_clearance`` and ``batch`` serves: :mod:`.oscillator` has one in
+    numpy for the independent check)."""
+
+    def __init__(self, contact: ContactModel, forcing: CasingForcing):
+        self.contact = contact
+        self.P = contact_basis(contact)
+        self.liner = forcing.liner(contact)
+        self._view = self.liner.attach(contact.kernel) if self.liner is not None else \
+            kernel.RRContact.from_buffer_copy(contact.kernel)
+        self._vref = ctypes.byref(self._view)
+        lib = _lib()
+        self._work = np.empty(lib.rr_batch_reduced_work_size(contact.n_dofs, contact.n_blades, contact.n_points,
+                                                             self.P.shape[0]))
+        self.g0 = float(contact.g0)
+
+    def set_clearance(self, g0: float) -> None:
+        self.g0 = float(g0)
+        self._view.g0 = self.g0
+
+    def batch(self, y: np.ndarray, yd: np.ndarray | None, omega: float, phi: np.ndarray | None,
+              jacobians: bool = True) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None, int]:
+        """f (m, r), P J P^T and P Jv P^T (m, r, r) at reduced states y, y' (m, r): one kernel call."""
+        m, r = y.shape
+        y = np.ascontiguousarray(y, dtype=float)
+        yd = None if yd is None else np.ascontiguousarray(yd, dtype=float)
+        F = np.empty((m, r))
+        J = np.empty((m, r, r)) if jacobians else None
+        Jv = np.empty((m, r, r)) if jacobians else None
+        ptr = kernel.ptr
+        touching = _lib().rr_batch_reduced(self._vref, m, ptr(y), None if yd is None else ptr(yd), float(omega),
+                                           None if phi is None else ptr(phi), r, ptr(self.P), ptr(F),
+                                           None if J is None else ptr(J), None if Jv is None else ptr(Jv),
+                                           ptr(self._work))
+        return F, J, Jv, int(touching)
+
+    def laws(self, q: np.ndarray, phi: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+        """Gaps (m, N, P) and per-blade law values (m, N, LAW_WIDTH) at full states q (m, n), one kernel call."""
+        c = self.contact
+        m = q.shape[0]
+        q = np.ascontiguousarray(q, dtype=float)
+        gaps = np.empty((m, c.n_blades, c.n_points))
+        law = np.empty((m, c.n_blades, kernel.LAW_WIDTH))
+        phi = None if phi is None else np.ascontiguousarray(phi, dtype=float)
+        _lib().rr_batch_laws(self._vref, m, kernel.ptr(q), None if phi is None else kernel.ptr(phi),
+                             kernel.ptr(gaps), kernel.ptr(law))
+        return gaps, law
+
+
 class HBProblem:
     """The condensed harmonic balance of one model, contact and casing surface.
 
     ``forcing``: the casing surface (:class:`.surface.CasingForcing`); None or round: the response is forced
     by the imbalance only (constant in the rotating frame: the static solution, or an autonomous orbit).
+    ``nonlinearity``: instead of ``contact``, any force in contact coordinates (:class:`KernelContact`'s
+    interface), with ``model`` any structure holding M, D, G(Omega), K_omega(Omega), force(Omega, me), n_dofs
+    and M_inv (:mod:`.oscillator`'s gap oscillator: the independent check).
     """
 
-    def __init__(self, model: Model, contact: ContactModel, harmonics: int, samples: int | None = None,
-                 forcing: CasingForcing | None = None, me: float | None = None, external: np.ndarray | None = None):
+    def __init__(self, model: Model, contact: ContactModel | None, harmonics: int, samples: int | None = None,
+                 forcing: CasingForcing | None = None, me: float | None = None, external: np.ndarray | None = None,
+                 nonlinearity=None):
         self.model, self.contact = model, contact
         self.basis = HarmonicBasis(harmonics, samples)
         self.forcing = forcing if forcing is not None else CasingForcing()
@@ -121,21 +191,22 @@ class HBProblem:
         if self.external is not None and self.external.shape != (2 * harmonics + 1, model.n_dofs):
             raise ParameterError(f"external: shape {self.external.shape}; accepted (2 H + 1, n) = "
                                  f"({2 * harmonics + 1}, {model.n_dofs})")
-        self.P = contact_basis(contact)
+        if nonlinearity is None:
+            if contact is None:
+                raise ParameterError("contact: None; accepted: a ContactModel (or a nonlinearity in its place)")
+            nonlinearity = KernelContact(contact, self.forcing)
+        self.nl = nonlinearity
+        self.P = np.asarray(nonlinearity.P)
         self.r = self.P.shape[0]
         self.n = model.n_dofs
-        self.liner = self.forcing.liner(contact)
-        self._view = self.liner.attach(contact.kernel) if self.liner is not None else \
-            kernel.RRContact.from_buffer_copy(contact.kernel)
-        self._vref = ctypes.byref(self._view)
-        self._work = np.empty(_lib().rr_batch_work_size(self.n, self.r))
+        self.liner = getattr(nonlinearity, "liner", None)
+        self._vref = getattr(nonlinearity, "_vref", None)
         b = self.basis
-        nh = b.size
-        # W[a, b, i] = P_dft[a, i] E[i, b]: the AFT of a sampled Jacobian, as one matrix product
-        self._W = (b.P[:, None, :] * b.E.T[None, :, :]).reshape(nh * nh, b.m)
-        self._Wd = (b.P[:, None, :] * b.dE.T[None, :, :]).reshape(nh * nh, b.m)
+        # the discrete harmonics k = 0..2H at the samples (the AFT of a sampled Jacobian, rr_batch_aft_assemble)
+        k2 = np.arange(2 * self.H + 1)
+        self._cos2 = np.cos(np.outer(k2, b.tau))
+        self._sin2 = np.sin(np.outer(k2, b.tau))
         self._lin_key = None
-        self.g0 = float(contact.g0)
 
     # ------------------------------------------------------------------ parameters
     @property
@@ -151,9 +222,12 @@ class HBProblem:
     def forced(self) -> bool:
         return not self.forcing.round
 
+    @property
+    def g0(self) -> float:
+        return float(self.nl.g0)
+
     def set_clearance(self, g0: float) -> None:
-        self.g0 = float(g0)
-        self._view.g0 = self.g0
+        self.nl.set_clearance(g0)
 
     def linear(self, omega: float, w: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(L (H+1, r, r) complex receptances P Z_k^-1 P^T, X (H+1, n, r) = Z_k^-1 P^T, q_lin (n,) = K^-1 F)."""
@@ -176,6 +250,7 @@ class HBProblem:
                 Qe[1::2], Qe[2::2] = Xe[1:].real, -Xe[1:].imag
                 self._ext = Qe
             self._lin = (L, X, q_lin)
+            self._Lri = (np.ascontiguousarray(L[1:].real), np.ascontiguousarray(L[1:].imag))
             self._lin_key = key
         return self._lin
 
@@ -185,38 +260,53 @@ class HBProblem:
         b = self.basis
         return b.E @ Y, w * (b.dE @ Y)
 
-    def phases(self, w: float, omega: float) -> np.ndarray | None:
+    def phases(self, w: float, omega: float, tau: np.ndarray | None = None) -> np.ndarray | None:
         """The surface's frame angle at the samples: phi = Omega t, t_i = tau_i / w (None: a round casing)."""
         if not self.forced:
             return None
-        return np.ascontiguousarray(self.basis.tau * (omega / w))
+        tau = self.basis.tau if tau is None else tau
+        return np.ascontiguousarray(tau * (omega / w))
 
     def kernel_batch(self, y: np.ndarray, yd: np.ndarray | None, omega: float, phi: np.ndarray | None,
                      jacobians: bool = True) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None, int]:
         """f (m, r), P J P^T, P Jv P^T (m, r, r) at reduced states y, y' (m, r)."""
-        m = y.shape[0]
-        Q = np.ascontiguousarray(y @ self.P)
-        Qd = None if yd is None else np.ascontiguousarray(yd @ self.P)
-        F = np.empty((m, self.r))
-        J = np.empty((m, self.r, self.r)) if jacobians else None
-        Jv = np.empty((m, self.r, self.r)) if jacobians else None
-        ptr = kernel.ptr
-        touching = _lib().rr_batch_eval(self._vref, m, ptr(Q), None if Qd is None else ptr(Qd), float(omega),
-                                        None if phi is None else ptr(phi), self.r, ptr(self.P), ptr(F),
-                                        None if J is None else ptr(J), None if Jv is None else ptr(Jv),
-                                        ptr(self._work))
-        return F, J, Jv, int(touching)
+        return self.nl.batch(y, yd, omega, phi, jacobians)
 
     def apply_L(self, L: np.ndarray, f: np.ndarray) -> np.ndarray:
         """The receptance on real coefficients f (2H+1, r, ...) -> (2H+1, r, ...)."""
-        out = np.empty(f.shape, dtype=float)
-        out[0] = np.tensordot(L[0].real, f[0], axes=1)
-        Lr, Li = L[1:].real, L[1:].imag
-        fc, fs = f[1::2], f[2::2]
-        ein = "kuv,kv...->ku..."
-        out[1::2] = np.einsum(ein, Lr, fc) + np.einsum(ein, Li, fs)
-        out[2::2] = np.einsum(ein, Lr, fs) - np.einsum(ein, Li, fc)
-        return out
+        shape = f.shape
+        f3 = f.reshape(shape[0], shape[1], -1)
+        out = np.empty(f3.shape, dtype=float)
+        out[0] = L[0].real @ f3[0]
+        if self._lin_key is not None and L is self._lin[0]:
+            Lr, Li = self._Lri
+        else:
+            Lr, Li = L[1:].real, L[1:].imag
+        fc, fs = f3[1::2], f3[2::2]
+        out[1::2] = Lr @ fc + Li @ fs
+        out[2::2] = Lr @ fs - Li @ fc
+        return out.reshape(shape)
+
+    def aft_jacobian(self, Jp: np.ndarray, Jvp: np.ndarray | None, w: float) -> np.ndarray:
+        """D ((2H+1) r, (2H+1) r): the AFT of sampled Jacobians, P_dft [J_i E_i + w Jv_i dE_i], through the
+        discrete harmonics of the samples (only the samples where some blade touches contribute)."""
+        b, r, H = self.basis, self.r, self.H
+        Jr = Jp.reshape(b.m, r * r)
+        act = np.flatnonzero(Jr.any(axis=1))
+        Cj = np.ascontiguousarray(self._cos2[:, act] @ Jr[act])
+        Sj = np.ascontiguousarray(self._sin2[:, act] @ Jr[act])
+        Cv = Sv = None
+        if Jvp is not None:
+            Jv = Jvp.reshape(b.m, r * r)
+            actv = np.flatnonzero(Jv.any(axis=1))
+            if actv.size:
+                Cv = np.ascontiguousarray(self._cos2[:, actv] @ Jv[actv])
+                Sv = np.ascontiguousarray(self._sin2[:, actv] @ Jv[actv])
+        D = np.empty((b.size * r, b.size * r))
+        ptr = kernel.ptr
+        _lib().rr_batch_aft_assemble(H, r, b.m, ptr(Cj), ptr(Sj), None if Cv is None else ptr(Cv),
+                                     None if Sv is None else ptr(Sv), float(w), ptr(D))
+        return D
 
     def evaluate(self, Y: np.ndarray, omega: float, w: float, jacobian: bool = True) -> Evaluation:
         """Residual (and Jacobian) at coefficients Y (N,) for spin omega and fundamental w."""
@@ -233,11 +323,11 @@ class HBProblem:
             R -= self._ext @ self.P.T
         Jac = None
         if jacobian:
-            D = (self._W @ Jp.reshape(b.m, r * r))
-            if np.any(Jvp):
-                D = D + w * (self._Wd @ Jvp.reshape(b.m, r * r))
-            D = D.reshape(nh, nh, r, r).transpose(0, 2, 1, 3).reshape(nh, r, nh * r)
-            Jac = np.eye(self.N) - self.apply_L(L, D).reshape(self.N, self.N)
+            if touching:
+                D = self.aft_jacobian(Jp, Jvp, w).reshape(nh, r, nh * r)
+                Jac = np.eye(self.N) - self.apply_L(L, D).reshape(self.N, self.N)
+            else:
+                Jac = np.eye(self.N)
         return Evaluation(R.ravel(), Jac, f_hat, touching, Jp, Jvp)
 
     # ------------------------------------------------------------------ the linear start and the full response
@@ -273,6 +363,15 @@ class HBProblem:
         a = self.basis.amplitudes(Y.reshape(self.basis.size, self.r))[1:]
         top = float(np.linalg.norm(a, axis=1).max())
         return float(np.linalg.norm(a[-1])) / top if top > 0 else 0.0
+
+
+def frequency_derivative(problem: HBProblem, Y: np.ndarray, omega: float, w: float) -> np.ndarray:
+    """dR/dw at fixed Y and Omega (an autonomous orbit's frequency is an unknown): central differences, step
+    1e-6 w (R is smooth in w: the receptances and the samples' velocities; error ~1e-12 relative)."""
+    h = 1e-6 * abs(w)
+    Rp = problem.evaluate(Y, omega, w + h, jacobian=False).R
+    Rm = problem.evaluate(Y, omega, w - h, jacobian=False).R
+    return (Rp - Rm) / (2 * h)
 
 
 @dataclass

@@ -6,13 +6,14 @@ Jacobians along the orbit (T-periodic), C = D + G(Omega), K = K(Omega).
 
 **Monodromy (primary).** The first-order form z' = (A0 + dA(t)) z, A0 the linear part and
 dA(t) = B [J(t), Jv(t)]-rows of rank r (the contact coordinates of :mod:`.problem`: dA = B Cr(t),
-B = [0; M^-1 P^T], Cr = [Jp P, Jvp P]), is integrated over one period by Strang splitting on a grid of
-``substeps`` x m steps: z <- e^{A0 h/2} e^{dA h} e^{A0 h/2} z, with e^{A0 h} exact (A0's eigen-decomposition,
-diagonal in its modal coordinates) and e^{dA h} = I + h B phi1(h Cr B) Cr exact (rank r; phi1(x) = (e^x - 1)/x).
-The splitting's error is O(h^2) in the multipliers; the Jacobians at the fine grid come from the orbit's
-Fourier series through the kernel (``rr_batch_eval``). Why primary: it needs no sorting of spurious
-exponents, its cost grows with the grid, not with (2n(2H+1))^3, and it is a time integration of the same
-orbit, independent of the balance's own Jacobian.
+B = [0; M^-1 P^T], Cr = [Jp P, Jvp P]), is integrated over one period by Strang splitting on a grid of steps
+(default m / 2, at least 64): z <- e^{A0 h/2} e^{dA h} e^{A0 h/2} z, with e^{A0 h} exact (A0's real modal form:
+2 x 2 rotation-scalings) and e^{dA h} = I + h B phi1(h Cr B) Cr exact (rank r; phi1(x) = (e^x - 1)/x), the
+Jacobian averaged over 4 samples of each step (the 2D law switches inside steps). The product runs in C
+(``rr_batch_monodromy``); the Jacobians come from the orbit's Fourier series through the kernel
+(``rr_batch_reduced``). An orbit that touches at no sample has the contact-free spectrum's multipliers. Why
+primary: it needs no sorting of spurious exponents, its cost grows with the grid, not with (2n(2H+1))^3, and
+it is a time integration of the same orbit, independent of the balance's own Jacobian.
 
 **Hill's method (check).** With x = e^{lambda t} p(t), p on the HB basis (coefficients (2H+1) x n, derivative
 operator N = w nabla (x) I):
@@ -31,11 +32,16 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import expm
 
-from .basis import HarmonicBasis
-from .problem import HBProblem
+from ... import kernel
+from .problem import HBProblem, _lib
 
 MULTIPLIER_TOL = 1e-6  # a multiplier within this of the unit circle is neutral (the splitting's resolution)
-DEFAULT_SUBSTEPS = 2  # measured: the leading multiplier moves by < 2e-5 from 2 to 16 substeps (3D), 1e-7 (2D)
+# the default grid: half a step per AFT sample (at least 64 steps), the Jacobian averaged over 4 samples in each
+# step. Measured on the oval reference at 3.25-3.75 Omega_ref against 4096 steps: the leading multiplier within
+# 4e-5 in 2D and 3D; without the averaging the 2D law's switching within a step costs up to 5e-3 (docs/THEORY.md
+# section 8)
+DEFAULT_SUBSTEPS = None
+DEFAULT_SUBSAMPLES = 4
 
 
 @dataclass
@@ -64,7 +70,9 @@ class Floquet:
 
 
 class _Modal:
-    """A0's eigen-decomposition at (Omega): z = S u, u' = Lambda u."""
+    """A0's eigen-decomposition at (Omega) in real modal form: z = S u, u' = Lambda u, Lambda block-diagonal (a real
+    eigenvalue, or a pair a +- i b acting on (Re v, Im v) as [[a, b], [-b, a]]): the monodromy's product then runs
+    in real arithmetic (a quarter of the complex flops)."""
 
     def __init__(self, problem: HBProblem, omega: float):
         m = problem.model
@@ -75,59 +83,137 @@ class _Modal:
         A0[:n, n:] = np.eye(n)
         A0[n:, :n] = -Minv @ K
         A0[n:, n:] = -Minv @ C
-        lam, S = np.linalg.eig(A0)
-        self.lam, self.S = lam, S
+        lam, V = np.linalg.eig(A0)
+        self.lam = lam
+        cols, size, re, im = [], [], [], []
+        scale = np.abs(lam).max() if lam.size else 1.0
+        for i in np.argsort(-lam.imag):  # pairs first (one of each), then the real ones
+            li = lam[i]
+            if li.imag > 1e-12 * scale:
+                cols += [V[:, i].real, V[:, i].imag]
+                size.append(2)
+                re.append(li.real)
+                im.append(li.imag)
+            elif abs(li.imag) <= 1e-12 * scale:
+                cols.append(V[:, i].real)
+                size.append(1)
+                re.append(li.real)
+                im.append(0.0)
+        S = np.column_stack(cols)
+        if S.shape != (2 * n, 2 * n):
+            raise np.linalg.LinAlgError("the modal form did not pair A0's eigenvalues")
+        self.S = S
         self.Sinv = np.linalg.inv(S)
+        self.size = np.array(size, dtype=np.int32)
+        self.re, self.im = np.array(re), np.array(im)
         B = np.zeros((2 * n, problem.r))
         B[n:] = Minv @ problem.P.T
-        self.Bt = self.Sinv @ B  # B in modal coordinates (2n x r)
+        self.Bt = np.ascontiguousarray(self.Sinv @ B)  # B in modal coordinates (2n x r)
         P = problem.P
-        self.Pq = np.hstack([P, np.zeros_like(P)]) @ S  # (r x 2n) y = P q in modal coordinates
-        self.Pv = np.hstack([np.zeros_like(P), P]) @ S  # y' = P q'
+        self.Pq = np.ascontiguousarray(np.hstack([P, np.zeros_like(P)]) @ S)  # (r x 2n) y = P q in modal coordinates
+        self.Pv = np.ascontiguousarray(np.hstack([np.zeros_like(P), P]) @ S)  # y' = P q'
         self.MB = P @ Minv @ P.T  # Cr B = Jvp (P M^-1 P^T)
 
 
-def monodromy_multipliers(problem: HBProblem, Y: np.ndarray, omega: float, w: float, substeps: int = DEFAULT_SUBSTEPS,
-                          autonomous: bool = False) -> Floquet:
-    """Floquet multipliers of the orbit Y by the split-exponential monodromy on substeps x m steps."""
+def _modal(problem: HBProblem, omega: float) -> _Modal:
+    """The modal form at omega, kept on the problem for the next call at the same speed (a continuation's
+    stability checks, the agreement's)."""
+    cache = getattr(problem, "_modal_cache", None)
+    if cache is None or cache[0] != float(omega):
+        cache = (float(omega), _Modal(problem, omega))
+        problem._modal_cache = cache
+    return cache[1]
+
+
+def linear_multipliers(problem: HBProblem, omega: float, w: float, autonomous: bool = False) -> Floquet:
+    """The multipliers of an orbit that touches nowhere: e^{lambda T}, lambda the contact-free spectrum at omega."""
+    m = problem.model
+    n = problem.n
+    A0 = np.zeros((2 * n, 2 * n))
+    A0[:n, n:] = np.eye(n)
+    A0[n:, :n] = -m.M_inv @ m.K_omega(omega)
+    A0[n:, n:] = -m.M_inv @ (m.D + m.G(omega))
+    lam = np.linalg.eigvals(A0)
+    return Floquet(_sorted(np.exp(lam * 2 * math.pi / w), autonomous), "linear (no contact on the orbit)", 0)
+
+
+def default_steps(problem: HBProblem) -> int:
+    """The monodromy's steps by default: m / 2, at least 64."""
+    return max(64, problem.basis.m // 2)
+
+
+def monodromy_multipliers(problem: HBProblem, Y: np.ndarray, omega: float, w: float,
+                          substeps: float | None = None,
+                          autonomous: bool = False, steps: int | None = None,
+                          subsamples: int = DEFAULT_SUBSAMPLES, return_matrix: bool = False) -> Floquet:
+    """Floquet multipliers of the orbit Y by the split-exponential monodromy on ``steps`` steps (or ``substeps``
+    per AFT sample; default :func:`default_steps`), each step's contact exponential taken with the mean of the
+    Jacobian over ``subsamples`` points of the step (where a blade enters or leaves contact within a step, the
+    mean weighs the part of the step it touches: the step's error there falls by that factor). An orbit that
+    touches at none of the samples has the contact-free system's multipliers (no product needed)."""
     b = problem.basis
-    ms = int(substeps) * b.m
-    fine = HarmonicBasis(b.harmonics, ms)
+    if steps is None:
+        steps = default_steps(problem) if substeps is None else int(round(substeps * b.m))
+    ms, sub = int(steps), int(subsamples)
+    if ms < 2 * b.harmonics + 2 or sub < 1:
+        raise ValueError(f"steps, subsamples: {ms}, {sub}; accepted steps >= 2 H + 2 = {2 * b.harmonics + 2}, "
+                         "subsamples >= 1")
     Yc = Y.reshape(b.size, problem.r)
-    y, yd = fine.E @ Yc, w * (fine.dE @ Yc)
-    phi = None if not problem.forced else np.ascontiguousarray(fine.tau * (omega / w))
-    _, Jp, Jvp, _ = problem.kernel_batch(y, yd, omega, phi, jacobians=True)
-    md = _Modal(problem, omega)
+    # the step centres tau_j = 2 pi j / ms; the sub-samples at the centres of sub equal parts of each step
+    tau = (2 * math.pi / ms) * (np.arange(ms)[:, None] + (np.arange(sub)[None, :] + 0.5) / sub - 0.5).ravel()
+    E = b.evaluate(np.eye(b.size), tau)
+    dE = b.evaluate(b.derivative(), tau)
+    y, yd = E @ Yc, w * (dE @ Yc)
+    phi = problem.phases(w, omega, tau)
+    _, Jp, Jvp, touching = problem.kernel_batch(y, yd, omega, phi, jacobians=True)
+    if touching == 0 and not return_matrix:
+        return linear_multipliers(problem, omega, w, autonomous)
+    r = problem.r
+    Jp = Jp.reshape(ms, sub, r, r).mean(axis=1)
+    Jvp = Jvp.reshape(ms, sub, r, r).mean(axis=1)
+    md = _modal(problem, omega)
     T = 2 * math.pi / w
     h = T / ms
-    d = np.exp(md.lam * h)
-    U = np.eye(2 * problem.n, dtype=complex)
+    r = problem.r
     has_v = Jvp.any(axis=(1, 2))
-    active = np.flatnonzero(Jp.any(axis=(1, 2)) | has_v)
-    # the contact rows in modal coordinates at every active step at once: Cr_j = Jp_j Pq + Jvp_j Pv (r x 2n)
-    Cr = np.einsum("juv,vk->juk", Jp[active], md.Pq)
-    if has_v.any():
-        Cr += np.einsum("juv,vk->juk", Jvp[active], md.Pv)
-    hB = h * md.Bt
-    half = np.exp(md.lam * h * 0.5)
-    last = -1  # free steps between active ones: one diagonal scaling (e^{A0 h} is diagonal here)
-    for a, j in enumerate(active):
-        # the free flow up to the middle of this step, the contact's exact exponential, then half a step
-        U *= (d ** (j - last - 1) * half)[:, None]
-        last = j
-        if has_v[j]:
+    act_mask = Jp.any(axis=(1, 2)) | has_v
+    active = np.flatnonzero(act_mask)
+    Jpa = np.ascontiguousarray(Jp[active])
+    Jva = np.ascontiguousarray(Jvp[active]) if has_v.any() else None
+    hB = np.ascontiguousarray(h * md.Bt)
+    Bx = None
+    if Jva is not None:  # where friction damps (low tip speeds): the rank-r exponential I + h B phi1(h Cr B) Cr
+        Bx = np.empty((active.size, 2 * problem.n, r))
+        for a, j in enumerate(active):
+            if not has_v[j]:
+                Bx[a] = hB
+                continue
             G = h * (Jvp[j] @ md.MB)
-            r = G.shape[0]
             aug = np.zeros((2 * r, 2 * r))
             aug[:r, :r] = G
             aug[:r, r:] = np.eye(r)
-            U += (hB @ expm(aug)[:r, r:]) @ (Cr[a] @ U)
-        else:
-            U += hB @ (Cr[a] @ U)
-        U *= half[:, None]
-    U *= (d ** (ms - 1 - last))[:, None]
+            Bx[a] = hB @ expm(aug)[:r, r:]
+    U = np.eye(2 * problem.n)
+    work = np.empty(2 * r * 2 * problem.n)
+    ptr = kernel.ptr
+    act_i = np.ascontiguousarray(act_mask.astype(np.int32))
+    done = _lib().rr_batch_monodromy(2 * problem.n, md.size.size, md.size.ctypes.data, ptr(md.re), ptr(md.im), ms,
+                                     float(h), act_i.ctypes.data, r, ptr(Jpa), None if Jva is None else ptr(Jva),
+                                     ptr(md.Pq), ptr(md.Pv), ptr(hB), None if Bx is None else ptr(Bx), ptr(U),
+                                     ptr(work))
+    if done < 0:
+        raise RuntimeError("rr_batch_monodromy: the modal blocks do not fill the state")
+    if return_matrix:
+        return md.S @ U @ md.Sinv  # the monodromy in (q, q')
     rho = np.linalg.eigvals(U)  # similar to the monodromy (modal coordinates)
     return Floquet(_sorted(rho, autonomous), "monodromy (split exponential)", ms)
+
+
+def monodromy_matrix(problem: HBProblem, Y: np.ndarray, omega: float, w: float, steps: int | None = None,
+                     subsamples: int = 4) -> np.ndarray:
+    """The monodromy matrix (2n x 2n, in (q, q') from t = -h/2) of the orbit Y (a Newton Jacobian for a
+    shooting reference: its fixed point does not depend on it)."""
+    return monodromy_multipliers(problem, Y, omega, w, steps=steps, subsamples=subsamples, return_matrix=True)
 
 
 def _sorted(rho: np.ndarray, autonomous: bool) -> np.ndarray:

@@ -1,0 +1,41 @@
+"""The forced-response command and its library function (rotorub_model/app/forced_response.py): the files it writes,
+the verdict, the HB-transient agreement with its reasons, and one-line errors on bad input."""
+
+from __future__ import annotations
+
+import json
+
+from rotorub_model.app.cli import main
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def test_forced_response_writes_the_map_and_says_where_hb_and_transients_disagree(tmp_path, capsys):
+    """2D, the default oval casing (2 lobes of 0.3 g0), 3.0-3.5 Omega_ref, two 60 s transients (serial): the map, its
+    harmonic content and the JSON are written; every transient speed carries a verdict; at 3.25 the HB orbit is
+    stable but its multiplier 0.995 leaves a 60 s transient settling, which the verdict names."""
+    out = tmp_path / "fr"
+    rc = main(["forced-response", "--out", str(out), "--speeds", "3.0", "3.25", "--g0", "0.5e-3", "--transients",
+               "2", "--executor", "serial"])
+    assert rc == 0
+    for name in ("interaction_map.png", "interaction_map_harmonics.png"):
+        assert (out / name).read_bytes()[:8] == PNG_MAGIC
+    s = json.loads((out / "interaction_map.json").read_text())
+    assert s["forcing"]["lobes"]["2"]["amplitude_m"] == 0.15e-3
+    assert s["branch_message"].endswith("reached omega = 173.55")
+    ag = {round(a["speed"], 3): a for a in s["agreement"]}
+    assert ag[3.0]["verdict"] == "agree" and ag[3.0]["transient"] == "periodic"
+    assert ag[3.25]["verdict"] == "disagree" and "not settled" in ag[3.25]["why"]
+    assert "DISAGREE at 1 speed" in s["verdict"]
+    assert "verdict" in capsys.readouterr().out
+
+
+def test_forced_response_bad_input(tmp_path, capsys):
+    for args, needle in ((["--lobe", "1", "--amplitude", "1e-4"], "lobes: 1 is the casing's rigid offset"),
+                         (["--lobe", "2"], "--amplitude"),
+                         (["--lobe", "2", "--amplitude", "0.02"], "clearances"),
+                         (["--harmonics", "1", "--lobe", "2", "--amplitude", "1e-4"], "fewer than the casing's lobe")):
+        rc = main(["forced-response", "--out", str(tmp_path / "x"), "--speeds", "3.0", "3.1", *args])
+        err = capsys.readouterr().err.strip().splitlines()
+        assert rc == 2 and len(err) == 1 and needle in err[0], (args, err)
+    assert not (tmp_path / "x").exists() or not any((tmp_path / "x").iterdir())
