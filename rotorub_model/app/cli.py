@@ -201,7 +201,7 @@ def _plot_static(contact, st, path: Path, title: str) -> None:
     from ..results import pyplot, save_figure
 
     plt = pyplot()
-    g = contact.gaps(st.q) * 1e3
+    g = contact.blade_forces(st.q, st.omega)["gap"] * 1e3  # per blade (an imported tip: its LE and TE stations)
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.6))
     x = range(1, len(st.forces_N) + 1)
     axes[0].bar(x, st.forces_N)

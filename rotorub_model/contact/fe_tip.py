@@ -10,10 +10,10 @@ evenly carries k_r times its penetration, as the built-in blades), and friction 
 of docs/THEORY.md §4 holds station by station: the leading edge, the trailing edge and every station between.
 
 The casing: a cone of half-angle theta whose line passes at g0 from the tip's tightest station (g0 is the tip's
-clearance, wherever along the chord it is smallest); a station at radius r and axial position z from the tip's
-mean axial position has the rest gap g0 + (R - z tan theta - r) cos theta - min over the stations of the same
-(a tip not cut to the casing's line keeps its own gaps: a flat-cut tip, whose ends reach further out than its
-middle, is tightest at its ends). The normal,
+clearance, wherever along the chord it is smallest); a node at radius r and axial position z from the tip's
+mean axial position has the rest gap g0 + (R - z tan theta - r) cos theta - min over the stations of the same,
+a station the mean of its nodes' (a tip not cut to the casing's line keeps its own gaps: a flat-cut tip facing a
+5 deg cone touches at its trailing edge only). The normal,
 the sliding direction and the casing's point maps (translation, tilt about its centre of gravity, ring) are the
 built-in formulation's at each station.
 
@@ -32,6 +32,14 @@ from .geometry import ContactGeometry, TipLayout
 
 SAME_STATION = 1e-3  # nodes closer than this fraction of the chord along it are one station
 DEFAULT_STATIONS = 12  # at most this many stations by default (more: finer, the segments' count)
+
+
+def tip_thickness(positions: np.ndarray) -> float:
+    """The tip's thickness [m]: the spread of its nodes across the chord (in the tip plane y, z; 0 for a tip
+    given as one line of nodes)."""
+    yz = positions[:, 1:] - positions[:, 1:].mean(axis=0)
+    _, _, vt = np.linalg.svd(yz, full_matrices=False)
+    return float(np.ptp(yz @ vt[1])) if vt.shape[0] > 1 else 0.0
 
 
 def stations(positions: np.ndarray, max_stations: int = DEFAULT_STATIONS) -> tuple[np.ndarray, np.ndarray, float]:
@@ -103,7 +111,10 @@ def geometry_fe(model: Model, theta: float, max_stations: int = DEFAULT_STATIONS
                 tan[s, end] = [-np.sin(a), np.cos(a), 0.0]
                 Jb[s, end][:, : node_Jb.shape[-1]] = node_Jb[j, nodes].mean(axis=0)  # rotor dofs (no casing)
                 Jc[s, end][:, cs] = casing_point_map(p, Pz)
-                g_off[s, end] = (R_tip - Pz[2] * t_th - np.hypot(P[0], P[1])) * c_th
+                # the station's rest gap: the mean of its nodes' own (a station spanning a stretch of the chord lies
+                # inside the tip's curved line, its nodes on it)
+                X = node_points[j, nodes]
+                g_off[s, end] = np.mean((R_tip - (X[:, 2] - z_tip) * t_th - np.hypot(X[:, 0], X[:, 1])) * c_th)
     # g0 is the clearance of the tip's tightest station: the cone passes at g0 from it (a flat-cut tip, whose ends
     # reach further out than its middle, keeps the larger gaps of its middle)
     g_off -= g_off.min()
@@ -133,9 +144,14 @@ def geometry_fe(model: Model, theta: float, max_stations: int = DEFAULT_STATIONS
             share[s, 0] = (0.5 * seg[k] + (0.5 * seg[k - 1] if k > 0 else 0.0)) / L
             share[s, 1] = 0.5 * seg[k] / L if k == K - 2 else 0.0
     point_row = np.array([[k, k + 1] for _ in range(N) for k in range(K - 1)], dtype=np.intc).ravel()
+    # the liner's band (the tip's axial extent) and the tip's footprint (chord x thickness; a tip given as one
+    # line of nodes: the [blades] thickness)
+    band = float(np.ptp(pts[: K - 1, :, 2]))
+    thick = tip_thickness(blade.tip_positions)
+    area = L * (thick if thick > 1e-6 * L else p.blades.thickness)
     tips = TipLayout(n_blades=N, n_dofs=n, seg_len=seg_len, seg_k=seg_len / L, g_off=g_off.ravel(), cols=cols,
                      blade_of=np.repeat(np.arange(N), K - 1).astype(np.intc), n_rows=K, point_row=point_row,
-                     point_share=share.ravel())
+                     point_share=share.ravel(), band=band, tip_area=area)
     T, _ = model.disk_maps
     return ContactGeometry(points=pts, normals=nor, tangents=tan, Jb=Jb, Jc=Jc, chord=L,
                            disk=np.ascontiguousarray(T[:2]), tips=tips, **compact)

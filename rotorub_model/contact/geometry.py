@@ -37,6 +37,8 @@ class TipLayout:
     n_rows: int  # rows of the liner's worn depth: the tip's stations
     point_row: np.ndarray  # (S*2,) intc: each point's station
     point_share: np.ndarray  # (S*2,) the liner's share of each point (its station's tributary chord; 0: a twin)
+    band: float = 0.0  # axial extent of the tip [m] (the band of the liner it sweeps)
+    tip_area: float = 0.0  # the tip's footprint on the liner [m^2]: its chord times its thickness (0: unknown)
 
 
 @dataclass

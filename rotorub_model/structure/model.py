@@ -16,6 +16,7 @@ Examples
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
@@ -154,6 +155,33 @@ def _place(n: int, parts: list[tuple[Matrices, np.ndarray]]) -> dict[str, np.nda
     return out
 
 
+TIP_RADIUS_TOL = 0.01  # an imported tip's radius may differ from [blades]' by this fraction (its own cut, a mesh)
+
+
+def check_fits(p: Parameters, blade) -> None:
+    """One line (ParameterError) when the imported blade does not fit the parameter file's [blades]: its tip (the
+    tip nodes' median radius) not at the tip radius hub_radius + length (within TIP_RADIUS_TOL: the casing's
+    line, the 2D tip and the liner sit there), or blades.count such blades overlapping their neighbours (the
+    blade's angular extent about the spin axis, over its nodes, wider than the pitch 360 deg / count)."""
+    from ..errors import ParameterError
+
+    where = f"fe_blade.superelement ({Path(p.fe_blade.superelement).name})"
+    r = float(np.median(np.hypot(blade.tip_positions[:, 0], blade.tip_positions[:, 1])))
+    R = p.blades.tip_radius
+    if not abs(r - R) <= TIP_RADIUS_TOL * R:
+        raise ParameterError(f"{where}: its tip lies at radius {r:.4g} m but [blades] puts the tips at hub_radius + "
+                             f"length = {R:.4g} m; accepted: within {TIP_RADIUS_TOL:.0%} (set blades.hub_radius and "
+                             "blades.length to the blade's)")
+    pts = blade.nodes if blade.nodes.shape[0] > blade.tip_positions.shape[0] else blade.tip_positions
+    a = np.arctan2(pts[:, 1], pts[:, 0])
+    span = float(a.max() - a.min())
+    pitch = 2.0 * np.pi / p.blades.count
+    if span >= pitch:
+        raise ParameterError(f"blades.count: {p.blades.count} blades of {where} overlap (each spans "
+                             f"{np.degrees(span):.3g} deg about the spin axis, the pitch is {np.degrees(pitch):.3g} "
+                             f"deg); accepted: at most {int(np.floor(2.0 * np.pi / span - 1e-9))}")
+
+
 def build_model(params: Parameters | None = None, mistuning: Sequence[float] | np.ndarray | None = None) -> Model:
     """Assemble the model of ``params`` (default: the embedded reference).
 
@@ -167,6 +195,10 @@ def build_model(params: Parameters | None = None, mistuning: Sequence[float] | n
         from ..fe.bladed_disk import fe_bladed_disk_matrices
 
         blade = load_superelement(p.fe_blade.superelement)
+        check_fits(p, blade)
+        # the blade's damping is the parameter file's (blades.damping_ratio, modal on every kept mode at rest), as
+        # for the built-in blades: the ratio the import stored is the one it was given, kept for its report
+        blade = dataclasses.replace(blade, damping_ratio=p.blades.damping_ratio)
         bd = fe_bladed_disk_matrices(p, blade)
         delta = check_mistuning(p, mistuning)
         if delta is not None:  # blade j's stiffness and damping times 1 + delta_j, as the built-in blades'
