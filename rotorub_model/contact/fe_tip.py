@@ -73,10 +73,36 @@ def stations(positions: np.ndarray, max_stations: int = DEFAULT_STATIONS) -> tup
     return members, station_c, chord
 
 
+def tip_node_maps(p, blade) -> tuple[np.ndarray, np.ndarray]:
+    """(points (N, n_t, 3), Jb (N, n_t, 3, n)): every tip node's rest position in the rotating frame (origin at
+    the fan disk's centre, z axial from the disk's station) and the map from the bladed disk's dofs [shaft,
+    blades] to its displacement: t + theta x rho0 + Rz(alpha_j) (tip_recovery @ q_j). ``blade``: anything with
+    ``tip_positions`` (n_t, 3), ``tip_recovery`` (n_t, 3, m) and ``m`` (a ReducedBlade, or a saved model's
+    :class:`~rotorub_model.structure.model.ImportedTip`); numpy only (the pythonfmu FMU's host has no scipy)."""
+    from ..structure.shaft import station_maps
+
+    ns = 2 * p.shaft.n_ritz
+    m = blade.m
+    N = p.blades.count
+    n = ns + N * m
+    T, Rm = station_maps(p, p.fan_disk.z)
+    nt = blade.tip_positions.shape[0]
+    points = np.zeros((N, nt, 3))
+    Jb = np.zeros((N, nt, 3, n))
+    for j in range(N):
+        a = 2.0 * np.pi * j / N
+        c, s = np.cos(a), np.sin(a)
+        R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        for i in range(nt):
+            rho0 = R @ blade.tip_positions[i]
+            points[j, i] = rho0
+            Jb[j, i, :, :ns] = T - np.cross(rho0[:, None], Rm, axis=0)
+            Jb[j, i, :, ns + j * m:ns + (j + 1) * m] = R @ blade.tip_recovery[i]
+    return points, Jb
+
+
 def geometry_fe(model: Model, theta: float, max_stations: int = DEFAULT_STATIONS) -> ContactGeometry:
     """The 3D contact geometry of ``model``'s imported blades (``model.fe_blade``)."""
-    from ..fe.bladed_disk import tip_point_maps
-
     p, blade = model.params, model.fe_blade
     if blade is None:
         raise ValueError("geometry_fe: the model has no imported blade")
@@ -85,7 +111,7 @@ def geometry_fe(model: Model, theta: float, max_stations: int = DEFAULT_STATIONS
     K = station_c.size
     if K < 2:
         raise ValueError("an imported tip needs two chord stations or more (its nodes are all at one chord position)")
-    node_points, node_Jb = tip_point_maps(p, blade)  # (N, n_t, 3), (N, n_t, 3, n)
+    node_points, node_Jb = tip_node_maps(p, blade)  # (N, n_t, 3), (N, n_t, 3, n)
     sh, bl, cs = model.slices["shaft"], model.slices["blades"], model.slices["casing"]
     m = blade.m
     R_tip, c_th, s_th, t_th = p.blades.tip_radius, np.cos(theta), np.sin(theta), np.tan(theta)

@@ -33,6 +33,27 @@ from .shaft import shaft_matrices, station_maps
 
 
 @dataclass
+class ImportedTip:
+    """What the contact and the outputs need of an imported blade (its tip and its mass), as :func:`save_model`
+    keeps it: numpy only, so that a saved model (the pythonfmu FMU's) builds its contact without scipy. A
+    :class:`~rotorub_model.fe.blade.ReducedBlade` has the same fields."""
+
+    tip_nodes: np.ndarray  # (n_t,) ids
+    tip_positions: np.ndarray  # (n_t, 3) rest positions, blade frame [m]
+    tip_recovery: np.ndarray  # (n_t, 3, m) tip displacement per unit reduced coordinate
+    nodes: np.ndarray  # (N, 3) the mesh's nodes (figures, the blade's angular extent)
+    mass: float  # [kg]
+    basis_mass: np.ndarray  # (6 + m, 6 + m): the rigid block holds the first moments (the static moment)
+
+    @property
+    def m(self) -> int:
+        return int(self.tip_recovery.shape[2])
+
+
+IMPORTED_FIELDS = ("tip_nodes", "tip_positions", "tip_recovery", "nodes", "basis_mass")
+
+
+@dataclass
 class Model:
     """Rotating-frame linear model: M q'' + (D + G(W)) q' + K(W) q = F(W^2).
 
@@ -55,7 +76,8 @@ class Model:
     slices: dict[str, slice]
     mistuning: tuple[float, ...] | None = None  # per-blade stiffness deviations (build_model); None: tuned
     S4: np.ndarray | None = None  # Omega^4 term of an imported blade's prestressed stiffness (None: the built-in's)
-    fe_blade: object | None = None  # the imported blade (fe.blade.ReducedBlade) when [fe_blade] names one
+    # the imported blade when [fe_blade] names one: fe.blade.ReducedBlade (build_model), ImportedTip (load_model)
+    fe_blade: object | None = None
 
     @property
     def blade_dofs(self) -> int:
@@ -263,10 +285,15 @@ def save_model(model: Model, path: str | Path) -> Path:
 
     T, R = model.disk_maps
     path = Path(path)
+    extra = {} if model.mistuning is None else {"mistuning": np.array(model.mistuning)}
+    if model.S4 is not None:
+        extra["S4"] = model.S4
+    if model.fe_blade is not None:  # an imported blade: what its contact needs (the superelement's path may not
+        b = model.fe_blade  # exist where the saved model goes: an FMU's host)
+        extra.update({f"fe_{k}": np.asarray(getattr(b, k)) for k in IMPORTED_FIELDS}, fe_mass=np.array(b.mass))
     np.savez(path, params=json.dumps(to_dict(model.params)), dofs=np.array(model.dofs),
              slices=json.dumps({k: [s.start, s.stop] for k, s in model.slices.items()}),
-             disk_T=T, disk_R=R, **{k: getattr(model, k) for k in _ARRAYS},
-             **({} if model.mistuning is None else {"mistuning": np.array(model.mistuning)}))
+             disk_T=T, disk_R=R, **{k: getattr(model, k) for k in _ARRAYS}, **extra)
     return path
 
 
@@ -284,4 +311,8 @@ def load_model(path: str | Path, params: Parameters | None = None) -> Model:
                   mistuning=tuple(float(v) for v in d["mistuning"]) if "mistuning" in d.files else None,
                   **{k: np.array(d[k]) for k in _ARRAYS})
         m.__dict__["disk_maps"] = (np.array(d["disk_T"]), np.array(d["disk_R"]))
+        if "S4" in d.files:
+            m.S4 = np.array(d["S4"])
+        if "fe_tip_recovery" in d.files:
+            m.fe_blade = ImportedTip(mass=float(d["fe_mass"]), **{k: np.array(d[f"fe_{k}"]) for k in IMPORTED_FIELDS})
     return m

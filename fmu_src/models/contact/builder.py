@@ -65,10 +65,43 @@ def _parameters(params_file: str | Path | None, mode: str):
     return path, load_parameters(path)  # validated now, not in the master
 
 
+def tip_data(model, theta: float) -> str:
+    """An imported blade's 3D tip for model_data.c (``MODEL_TIP``): the contact's own arrays as the library builds
+    them at cone angle ``theta`` [rad] (contact/fe_tip.py: the chord stations' segments, compact rows, rest gap
+    offsets, the liner's rows and shares), so that the native FMU's contact is the library's to the bit; or the
+    null pointer for the built-in blades (their geometry is rr_contact_geometry's, built at initialisation)."""
+    import math
+
+    from rotorub_model.contact import make_contact
+
+    if model.fe_blade is None:
+        return "static const model_tip *const MODEL_TIP = 0;\n"
+    # the cone angle as the pythonfmu FMU hands it to the library (degrees from the FMU's radians)
+    c = make_contact(model, "3D", theta_deg=math.degrees(theta))
+    g, t = c.geometry, c.geometry.tips
+    out = []
+    for key, a in (("TIP_G", g.G), ("TIP_A", g.A), ("TIP_B", g.B), ("TIP_S", g.S), ("TIP_POINTS", g.points),
+                   ("TIP_NORMALS", g.normals), ("TIP_TANGENTS", g.tangents), ("TIP_SEG_LEN", t.seg_len),
+                   ("TIP_SEG_K", t.seg_k), ("TIP_G_OFF", t.g_off), ("TIP_SHARE", t.point_share)):
+        out.append(c_array(key, a.ravel()))
+    for key, a in (("TIP_COLS", t.cols), ("TIP_BLADE_OF", t.blade_of), ("TIP_POINT_ROW", t.point_row)):
+        out.append(c_array(key, a.ravel(), "int"))
+    out.append(
+        "static const model_tip TIP = {\n"
+        f"    {c.n_segments}, {t.cols.shape[1]}, {t.n_blades}, {t.n_rows},\n"
+        f"    {c_double(max(g.chord, 1e-300))}, {c_double(t.band)}, {c_double(t.tip_area)},\n"
+        "    TIP_SEG_LEN, TIP_SEG_K, TIP_G_OFF, TIP_SHARE, TIP_COLS, TIP_BLADE_OF, TIP_POINT_ROW,\n"
+        "    TIP_G, TIP_A, TIP_B, TIP_S, TIP_POINTS, TIP_NORMALS, TIP_TANGENTS\n};\n"
+        "static const model_tip *const MODEL_TIP = &TIP;\n")
+    return "\n".join(out)
+
+
 def model_data(model, variables) -> str:
     """The contact model's part of model_data.c: where the kernel's outputs go, the structure's matrices and the
-    contact geometry's ingredients."""
+    contact geometry's ingredients (an imported blade: its 3D tip's arrays, the Omega^4 term, and the block layout
+    the time step takes from the library's BLOCK_MIN_DOFS on)."""
     from rotorub_model import kernel
+    from rotorub_model.analyses.transient import BLOCK_MIN_DOFS
     from rotorub_model.contact.geometry import geometry_spec
 
     vr = {v.name: v.vr for v in scalars(declared(variables, ("fmi2", "native")))}
@@ -76,6 +109,10 @@ def model_data(model, variables) -> str:
     index = [vr[f"blade[{j}].{b}"] for b in kernel.OUT_BLADE_NAMES for j in range(1, nb + 1)]
     index += [vr[g] for g in kernel.OUT_GLOBAL_NAMES]
     spec = geometry_spec(model, 2, 0.0, 0.0, True)
+    theta = next(v.start for v in variables if v.name == "theta")
+    # the step by blocks where the library's CentralDifference takes it (the same dof count, the same layout)
+    layout = model.block_layout if model.n_dofs >= BLOCK_MIN_DOFS else None
+    blocks = layout or (0, 0, 0, 0)
     # rr_surface_summary's values in the kernel's order (depth_max, ..., lobes, harmonic_1, ...)
     wear = [vr[f"wear.harmonic[{n.rpartition('_')[2]}]" if n.startswith("harmonic_") else f"wear.{n}"]
             for n in kernel.WEAR_NAMES]
@@ -86,6 +123,8 @@ def model_data(model, variables) -> str:
     ]
     for key in ("M", "D", "K", "G1", "C1", "N2", "S2", "f_unit"):
         out.append(c_array(key, getattr(model, key).ravel()))
+    out.append(c_array("S4", model.S4.ravel()) if model.S4 is not None else "#define S4 0\n")
+    out.append(tip_data(model, theta))
     out.append(c_array("PSI_TIP", spec["psi_tip"]))
     out.append(c_array("MODES", spec["modes"], "int"))
     out.append(c_array("T_DISK", spec["T"].ravel()))
@@ -96,7 +135,8 @@ def model_data(model, variables) -> str:
         "    M, D, K, G1, C1, N2, S2, f_unit,\n"
         f"    {c_double(spec['r_tip'])}, {c_double(spec['stagger'])}, {c_double(spec['z_cg'])},\n"
         f"    {spec['blade_dof0']}, {spec['n_ritz']}, {spec['casing_dof0']}, {len(spec['modes'])},\n"
-        "    PSI_TIP, MODES, T_DISK, R_DISK\n};\n")
+        "    PSI_TIP, MODES, T_DISK, R_DISK,\n"
+        f"    S4, {blocks[0]}, {blocks[1]}, {blocks[2]}, {blocks[3]}, MODEL_TIP\n}};\n")
     return "\n".join(out)
 
 
@@ -115,7 +155,7 @@ def build_native_fmu(dest: str | Path = "fmus/native", params_file: str | Path |
 
     params_path, params = _parameters(params_file, mode)
     model = build_model(params)
-    defaults = cv.Defaults.from_parameters(params)
+    defaults = cv.Defaults.from_parameters(params, model)
     variables = cv.variables(defaults, mode)
     three = fmi == "3.0"
     facts = (f"{'FMI 3.0. ' if three else ''}Model built in from <code>{html.escape(params_path.name)}</code>; "
@@ -221,7 +261,8 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
     except NativeBuildError as exc:
         raise BuildError(str(exc)) from None
     files = _library_files()
-    variables = cv.variables(cv.Defaults.from_parameters(params), mode)
+    model = build_model(params)
+    variables = cv.variables(cv.Defaults.from_parameters(params, model), mode)
     own = scalars(declared(variables, ("fmi2", "pythonfmu")))
     h = hashlib.sha256()
     for p in [SLAVE, params_path, *files]:
@@ -250,7 +291,6 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
                 out.write_text(_check_relative_only(p, p.read_text()))
             else:
                 shutil.copy2(p, out)
-        model = build_model(params)
         save_model(model, Path(tmp) / "model.npz")
         manifest["n_dofs"] = model.n_dofs
         manifest["parameter_values"] = to_dict(params)  # read without a TOML parser (Python 3.10 has none)

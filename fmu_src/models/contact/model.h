@@ -17,6 +17,19 @@
 #define MODEL_HAS_STEP_TO_EVENT /* FMI 3.0 early return at a first contact */
 #define MODEL_HAS_TIME_ADVANCED /* a divergence reports the substep it reached */
 
+/* An imported blade's 3D tip (docs/THEORY.md 9), the library's arrays as built at the parameter file's cone angle
+ * (contact/fe_tip.py): nseg segments between chord stations, each a 'blade' of the kernel with compact rows over
+ * nloc dofs; the outputs report nb_out blades; the liner has n_rows rows (the stations). */
+typedef struct {
+    int nseg, nloc, nb_out, n_rows;
+    double chord;    /* the tip's chord, leading to trailing station [m] */
+    double band;     /* its axial extent: the band of the liner it sweeps [m] */
+    double tip_area; /* its footprint on the liner [m^2] */
+    const double *seg_len, *seg_k, *g_off, *point_share;
+    const int *cols, *blade_of, *point_row;
+    const double *G, *A, *B, *S, *points, *normals, *tangents;
+} model_tip;
+
 typedef struct {
     int n;                 /* generalised coordinates */
     int nb;                /* blades */
@@ -28,6 +41,10 @@ typedef struct {
     const double *psi_tip;
     const int *modes;
     const double *T, *Rot; /* (3, n) fan-disk translation and rotation */
+    const double *S4;      /* (n, n) an imported blade's Omega^4 prestress term, or NULL */
+    int blk_ns, blk_nb, blk_m, blk_nc; /* the time step by blocks (hub, blades, casing) when blk_nb > 0: where the
+                                        * library's CentralDifference takes it (BLOCK_MIN_DOFS), the same bits */
+    const model_tip *tip;  /* an imported blade's 3D tip, or NULL (the built-in LE/TE, rr_contact_geometry) */
 } model_data;
 
 extern const model_data MODEL_DATA;

@@ -87,7 +87,7 @@ class OrbitView:
         pb = self.problem
         c = pb.contact
         lib = c.lib
-        N, P = c.n_blades, c.n_points
+        N, P = c.n_segments, c.n_points
         from ... import kernel
 
         F = np.empty((self.fine.m, N))
