@@ -216,6 +216,11 @@ def build_model(params: Parameters | None = None, mistuning: Sequence[float] | n
         from ..fe.blade import load_superelement
         from ..fe.bladed_disk import fe_bladed_disk_matrices
 
+        if not Path(p.fe_blade.superelement).is_file():
+            from ..errors import ParameterError
+
+            raise ParameterError(f"fe_blade.superelement: {p.fe_blade.superelement}: no such file; accepted: the "
+                                 "blade.npz rotorub import-blade wrote (a path relative to the parameter file)")
         blade = load_superelement(p.fe_blade.superelement)
         check_fits(p, blade)
         # the blade's damping is the parameter file's (blades.damping_ratio, modal on every kept mode at rest), as
