@@ -434,4 +434,8 @@ def make_contact(model: Model, formulation: str = "3D", variant: str = "full", *
         if variant == "kinematics_only":
             theta, chord = 0.0, 1e-3
         geo = geometry_3d(model, theta, chord, rotations=variant != "geometry_only")
+    if getattr(model, "casing_ratios", None) is not None and geo.tips is None:  # an FE casing's modes
+        from .geometry import with_fe_casing
+
+        geo = with_fe_casing(model, geo)
     return ContactModel(formulation, variant, geo, c.g0, c.k_r, c.mu, c.slip_velocity, c.law, c.law_params)

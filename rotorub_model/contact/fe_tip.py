@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..structure.casing import casing_point_map
 from ..structure.model import Model
 from .geometry import ContactGeometry, TipLayout
 
@@ -136,7 +135,7 @@ def geometry_fe(model: Model, theta: float, max_stations: int = DEFAULT_STATIONS
                 nor[s, end] = c_th * e_rho + s_th * np.array([0.0, 0.0, 1.0])
                 tan[s, end] = [-np.sin(a), np.cos(a), 0.0]
                 Jb[s, end][:, : node_Jb.shape[-1]] = node_Jb[j, nodes].mean(axis=0)  # rotor dofs (no casing)
-                Jc[s, end][:, cs] = casing_point_map(p, Pz)
+                Jc[s, end][:, cs] = model.casing_point_map(Pz)
                 # the station's rest gap: the mean of its nodes' own (a station spanning a stretch of the chord lies
                 # inside the tip's curved line, its nodes on it)
                 X = node_points[j, nodes]

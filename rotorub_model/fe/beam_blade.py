@@ -117,14 +117,14 @@ def write_beam_blade(p: Parameters, folder: str | Path, speeds: tuple[float, ...
             "axis_direction": (0.0, float(np.sin(beta)), float(np.cos(beta))), "tip_node": int(ids[-1])}
 
 
-def chord_end_points(p: Parameters, chord: float, theta_deg: float) -> np.ndarray:
+def chord_end_points(p: Parameters, chord: float, theta_deg: float, stations: int = 2) -> np.ndarray:
     """The built-in 3D formulation's leading- and trailing-edge rest points of blade 0 (2, 3), blade frame (e_r,
     e_t, e_z): l_c apart along the stagger (cos(beta) e_z - sin(beta) e_t), on the cone R_tip - z tan(theta) (the
-    kernel's rr_contact_geometry, written out)."""
+    kernel's rr_contact_geometry, written out); ``stations`` > 2: that many points evenly between them."""
     b = p.blades
     beta, th = np.radians(b.stagger_deg), np.radians(theta_deg)
     out = []
-    for c in (-0.5 * chord, 0.5 * chord):
+    for c in np.linspace(-0.5 * chord, 0.5 * chord, stations):
         P0 = np.array([b.tip_radius, -c * np.sin(beta), c * np.cos(beta)])
         ap, z = np.arctan2(P0[1], P0[0]), P0[2]
         rad = b.tip_radius - z * np.tan(th)
@@ -132,18 +132,20 @@ def chord_end_points(p: Parameters, chord: float, theta_deg: float) -> np.ndarra
     return np.array(out)
 
 
-def with_chord_ends(blade: ReducedBlade, p: Parameters, chord: float, theta_deg: float) -> ReducedBlade:
+def with_chord_ends(blade: ReducedBlade, p: Parameters, chord: float, theta_deg: float,
+                    stations: int = 2) -> ReducedBlade:
     """The imported beam ``blade`` (one tip node) with its tip at the built-in 3D formulation's two chord ends
     (:func:`chord_end_points`), each with the tip node's recovery: the same two contact stations, at the same
-    places, moving as the built-in's do (module docstring)."""
+    places, moving as the built-in's do (module docstring); ``stations`` > 2: as many evenly along the chord."""
     import dataclasses
 
     if blade.tip_nodes.size != 1:
         raise ValueError("with_chord_ends: a beam blade with one tip node")
-    rec = np.repeat(blade.tip_recovery, 2, axis=0)
+    k = int(stations)
+    rec = np.repeat(blade.tip_recovery, k, axis=0)
     G = blade.tip_residual
-    res = np.kron(np.ones((2, 2)), G) if G.size else G
-    cen = np.repeat(blade.tip_centrifugal, 2, axis=0)
-    ids = np.array([int(blade.tip_nodes[0]) * 10 + 1, int(blade.tip_nodes[0]) * 10 + 2])
-    return dataclasses.replace(blade, tip_nodes=ids, tip_positions=chord_end_points(p, chord, theta_deg),
+    res = np.kron(np.ones((k, k)), G) if G.size else G
+    cen = np.repeat(blade.tip_centrifugal, k, axis=0)
+    ids = int(blade.tip_nodes[0]) * 100 + 1 + np.arange(k)
+    return dataclasses.replace(blade, tip_nodes=ids, tip_positions=chord_end_points(p, chord, theta_deg, k),
                                tip_recovery=rec, tip_residual=res, tip_centrifugal=cen)

@@ -78,6 +78,14 @@ class Model:
     S4: np.ndarray | None = None  # Omega^4 term of an imported blade's prestressed stiffness (None: the built-in's)
     # the imported blade when [fe_blade] names one: fe.blade.ReducedBlade (build_model), ImportedTip (load_model)
     fe_blade: object | None = None
+    # an FE casing's (``[fe_casing]``) tangential and axial ratios of each of casing.modes; None: the thin ring's
+    casing_ratios: tuple[np.ndarray, np.ndarray] | None = None
+
+    def casing_point_map(self, point: np.ndarray) -> np.ndarray:
+        """3 x n_casing: the casing surface point's displacement (structure/casing.py; an FE casing's modes)."""
+        from .casing import casing_point_map
+
+        return casing_point_map(self.params, point, *(self.casing_ratios or (None, None)))
 
     @property
     def blade_dofs(self) -> int:
@@ -177,6 +185,36 @@ def _place(n: int, parts: list[tuple[Matrices, np.ndarray]]) -> dict[str, np.nda
     return out
 
 
+CASING_RADIUS_TOL = 0.1  # an FE casing's contact circle within this fraction of the tip radius (its surface or
+# mid-surface, a mesh)
+
+
+def fe_casing(p: Parameters):
+    """(the casing block, (tau, zeta) of each of casing.modes) of [fe_casing]'s modal model, its modes damped by
+    [casing].damping_ratio (as the ring's: the file's ratio is what it was written with)."""
+    from ..errors import ParameterError
+    from ..fe.casing_modes import CasingMode, FECasing, fe_casing_matrices, load_fe_casing
+
+    where = f"fe_casing.model ({Path(p.fe_casing.model).name})"
+    if not Path(p.fe_casing.model).is_file():
+        raise ParameterError(f"fe_casing.model: {p.fe_casing.model}: no such file; accepted: an FE casing's modal "
+                             "model that FECasing.save wrote (a path relative to the parameter file)")
+    cas = load_fe_casing(p.fe_casing.model)
+    have = [m.n for m in cas.modes]
+    missing = [n for n in p.casing.modes if n not in have]
+    if missing:
+        raise ParameterError(f"casing.modes: {list(p.casing.modes)} but {where} has modes of {have} nodal "
+                             f"diameters; accepted: nodal diameters among {have}")
+    R = p.blades.tip_radius
+    if not abs(cas.radius - R) <= CASING_RADIUS_TOL * R:
+        raise ParameterError(f"{where}: its contact circle has radius {cas.radius:.4g} m, the blade tips are at "
+                             f"{R:.4g} m; accepted: within {CASING_RADIUS_TOL:.0%} (a model of this casing, sampled "
+                             "where the tips meet it)")
+    damped = FECasing(cas.radius, tuple(CasingMode(**{**m.__dict__, "damping_ratio": p.casing.damping_ratio})
+                                        for m in cas.modes), cas.info)
+    return fe_casing_matrices(p, damped), damped.ratios(p.casing.modes)
+
+
 TIP_RADIUS_TOL = 0.01  # an imported tip's radius may differ from [blades]' by this fraction (its own cut, a mesh)
 
 
@@ -236,7 +274,9 @@ def build_model(params: Parameters | None = None, mistuning: Sequence[float] | n
                 bd.D[sl, sl] *= 1.0 + dj
     else:
         bd = bladed_disk_matrices(p, mistuning=mistuning)
-    cs = casing_matrices(p)
+    cs, ratios = casing_matrices(p), None
+    if p.fe_casing.model:  # an FE casing's modes in place of the ring's (docs/THEORY.md 9.6)
+        cs, ratios = fe_casing(p)
     ns = len(sh.dofs)
     nbt = len(bd.dofs) - ns
     nc = len(cs.dofs)
@@ -259,6 +299,7 @@ def build_model(params: Parameters | None = None, mistuning: Sequence[float] | n
     model = Model(params=p, dofs=dofs, f_unit=np.zeros(n), f_tangential=np.zeros(n), f_euler=np.zeros(n),
                   slices=slices, mistuning=check_mistuning(p, mistuning), **mats)
     model.f_euler[slices["rotor"]] = bd.f_euler
+    model.casing_ratios = ratios
     if blade is not None:
         model.fe_blade = blade
         model.S4 = np.zeros((n, n))
@@ -293,6 +334,8 @@ def save_model(model: Model, path: str | Path) -> Path:
     extra = {} if model.mistuning is None else {"mistuning": np.array(model.mistuning)}
     if model.S4 is not None:
         extra["S4"] = model.S4
+    if model.casing_ratios is not None:
+        extra["casing_tau"], extra["casing_zeta"] = model.casing_ratios
     if model.fe_blade is not None:  # an imported blade: what its contact needs (the superelement's path may not
         b = model.fe_blade  # exist where the saved model goes: an FMU's host)
         extra.update({f"fe_{k}": np.asarray(getattr(b, k)) for k in IMPORTED_FIELDS}, fe_mass=np.array(b.mass))
@@ -318,6 +361,8 @@ def load_model(path: str | Path, params: Parameters | None = None) -> Model:
         m.__dict__["disk_maps"] = (np.array(d["disk_T"]), np.array(d["disk_R"]))
         if "S4" in d.files:
             m.S4 = np.array(d["S4"])
+        if "casing_tau" in d.files:
+            m.casing_ratios = (np.array(d["casing_tau"]), np.array(d["casing_zeta"]))
         if "fe_tip_recovery" in d.files:
             m.fe_blade = ImportedTip(mass=float(d["fe_mass"]), **{k: np.array(d[f"fe_{k}"]) for k in IMPORTED_FIELDS})
     return m

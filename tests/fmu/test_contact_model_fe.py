@@ -194,11 +194,12 @@ def test_the_tip_geometry_is_built_in(example):
         v = {x.name: x for x in read_model_description(f).modelVariables}
         assert float(v["theta"].min) == float(v["theta"].max) == pytest.approx(theta)
         assert float(v["chord"].start) == pytest.approx(make_contact(model, "3D").geometry.chord)
-        assert "imported" in v["theta"].description
+        assert "Built in" in v["theta"].description
     with pytest.raises(FMUError), Slave(fmus["native"], theta=0.0) as s:
         s.step(0.0, 1e-3)
 
 
+@pytest.mark.slow  # the kit's 2 s run-up through both flavours and the library's reference: 20-25 s on 2 cores
 def test_crosscheck_kit_of_the_example(example, tmp_path):
     """The cross-check kit written for the example's FMUs (rotorub build-fmu --params example.toml writes it):
     both flavours reproduce it through fmpy."""
@@ -212,6 +213,7 @@ def test_crosscheck_kit_of_the_example(example, tmp_path):
         assert max(diff.values()) <= 1e-9, diff
 
 
+@pytest.mark.slow  # an FMI 3.0 build, the library's reference of the kit and the run: about 20 s on 2 cores
 def test_fmi3_fmu_of_the_example_reproduces_its_kit(tmp_path):
     """`rotorub build-fmu --native --fmi3 --params example.toml`: the FMI 3.0 FMU (per-blade arrays) with the
     imported tip reproduces its own kit (FMI 3.0 columns) to the kit's bound."""
@@ -222,3 +224,36 @@ def test_fmi3_fmu_of_the_example_reproduces_its_kit(tmp_path):
     r3 = runs.run_fmi3(out["fmu"], tmp_path)
     assert r3["n_contact"].max() >= 1
     assert max(runs.compare(r3, tmp_path).values()) <= 1e-9
+
+
+@pytest.fixture(scope="module")
+def fe_casing(tmp_path_factory):
+    """The reference's blades facing a thin ring's modes from 180 FE frames ([fe_casing]): both FMUs."""
+    from rotorub_model.fe.casing_modes import casing_from_matrices
+    from rotorub_model.fe.coordinates import read_coordinates
+    from rotorub_model.fe.matrix_market import read_dof_map, read_mm
+    from rotorub_model.fe.ring_model import write_ring
+    from rotorub_model.structure.params import REFERENCE_FILE
+
+    d = tmp_path_factory.mktemp("fe_casing_fmu")
+    text = REFERENCE_FILE.read_text().replace("ring_thickness = 0.135 ", "ring_thickness = 0.0135 ")
+    f = d / "thin.toml"
+    f.write_text(text + '\n[fe_casing]\nmodel = "casing.json"\n')
+    info = write_ring(load_parameters(REFERENCE_FILE).replace(casing={"ring_thickness": 0.0135}), d / "ring", 180)
+    nodes, comps = read_dof_map(info["dofs"])
+    ids, xyz = read_coordinates(info["coordinates"])
+    casing_from_matrices(read_mm(info["stiffness"]), read_mm(info["mass"]), nodes, comps, ids, xyz,
+                         info["circle_nodes"], keep=(2, 3)).save(d / "casing.json")
+    model = build_model(load_parameters(f))
+    assert model.casing_ratios is not None
+    return _builds(f, d), model
+
+
+@pytest.mark.parametrize("formulation", ["3D", "2D"])
+def test_fe_casing_transient_equals_library(fe_casing, formulation):
+    """The built-in blades against an FE casing's modes: the geometry the kernel cannot make (its tangential
+    ratios are the FE's) is built into the native FMU as the library makes it; the same bits in both FMUs, the
+    library's to 1e-9."""
+    fmus, model = fe_casing
+    runs, lib = _transient(fmus, model, formulation, 0.5e-3)
+    _check_against_library(runs, lib, model.params.blades.count)

@@ -33,6 +33,8 @@ import tempfile
 import zipfile
 from pathlib import Path
 
+import numpy as np
+
 import rotorub_model
 
 from ...fmi.compile import NativeBuildError
@@ -65,41 +67,57 @@ def _parameters(params_file: str | Path | None, mode: str):
     return path, load_parameters(path)  # validated now, not in the master
 
 
-def tip_data(model, theta: float) -> str:
-    """An imported blade's 3D tip for model_data.c (``MODEL_TIP``): the contact's own arrays as the library builds
-    them at cone angle ``theta`` [rad] (contact/fe_tip.py: the chord stations' segments, compact rows, rest gap
-    offsets, the liner's rows and shares), so that the native FMU's contact is the library's to the bit; or the
-    null pointer for the built-in blades (their geometry is rr_contact_geometry's, built at initialisation)."""
+def geometry_data(model, theta: float, chord: float) -> str:
+    """The contact geometries built into model_data.c (``MODEL_GEO2D``, ``MODEL_GEO3D``): where the kernel's
+    rr_contact_geometry cannot build them at initialisation, the library's own arrays at cone angle ``theta``
+    [rad] and chord ``chord`` [m] (the FMU's start values, as the pythonfmu FMU hands them to the library), so that
+    the native FMU's contact is the library's to the bit: an imported blade's 3D tip (contact/fe_tip.py: its
+    segments, compact rows, rest gap offsets, the liner's rows and shares), the built-in blades facing an FE
+    casing's modes (contact/geometry.py with_fe_casing), 2D and 3D. Otherwise the null pointer."""
     import math
 
     from rotorub_model.contact import make_contact
 
-    if model.fe_blade is None:
-        return "static const model_tip *const MODEL_TIP = 0;\n"
-    # the cone angle as the pythonfmu FMU hands it to the library (degrees from the FMU's radians)
-    c = make_contact(model, "3D", theta_deg=math.degrees(theta))
-    g, t = c.geometry, c.geometry.tips
     out = []
-    for key, a in (("TIP_G", g.G), ("TIP_A", g.A), ("TIP_B", g.B), ("TIP_S", g.S), ("TIP_POINTS", g.points),
-                   ("TIP_NORMALS", g.normals), ("TIP_TANGENTS", g.tangents), ("TIP_SEG_LEN", t.seg_len),
-                   ("TIP_SEG_K", t.seg_k), ("TIP_G_OFF", t.g_off), ("TIP_SHARE", t.point_share)):
-        out.append(c_array(key, a.ravel()))
-    for key, a in (("TIP_COLS", t.cols), ("TIP_BLADE_OF", t.blade_of), ("TIP_POINT_ROW", t.point_row)):
-        out.append(c_array(key, a.ravel(), "int"))
-    out.append(
-        "static const model_tip TIP = {\n"
-        f"    {c.n_segments}, {t.cols.shape[1]}, {t.n_blades}, {t.n_rows},\n"
-        f"    {c_double(max(g.chord, 1e-300))}, {c_double(t.band)}, {c_double(t.tip_area)},\n"
-        "    TIP_SEG_LEN, TIP_SEG_K, TIP_G_OFF, TIP_SHARE, TIP_COLS, TIP_BLADE_OF, TIP_POINT_ROW,\n"
-        "    TIP_G, TIP_A, TIP_B, TIP_S, TIP_POINTS, TIP_NORMALS, TIP_TANGENTS\n};\n"
-        "static const model_tip *const MODEL_TIP = &TIP;\n")
+    for form in ("2D", "3D"):
+        name = f"GEO{form}"
+        if not ((form == "3D" and model.fe_blade is not None) or model.casing_ratios is not None):
+            out.append(f"#define MODEL_{name} 0\n")
+            continue
+        c = make_contact(model, form, theta_deg=math.degrees(theta), chord=chord)
+        g, t = c.geometry, c.geometry.tips
+        arrays = {"G": g.G, "A": g.A, "B": g.B, "S": g.S, "POINTS": g.points, "NORMALS": g.normals,
+                  "TANGENTS": g.tangents}
+        ints = {}
+        if t is not None:
+            arrays.update(SEG_LEN=t.seg_len, SEG_K=t.seg_k, G_OFF=t.g_off, SHARE=t.point_share)
+            ints = {"COLS": t.cols, "BLADE_OF": t.blade_of, "POINT_ROW": t.point_row}
+        for key, a in arrays.items():
+            out.append(c_array(f"{name}_{key}", np.asarray(a).ravel()))
+        for key, a in ints.items():
+            out.append(c_array(f"{name}_{key}", np.asarray(a).ravel(), "int"))
+
+        have = {*arrays, *ints}
+
+        def ref(keys: tuple[str, ...], name: str = name, have: set = have) -> str:
+            return ", ".join(f"{name}_{k}" if k in have else "0" for k in keys)
+
+        head = (f"{c.n_segments}, {t.cols.shape[1]}, {t.n_blades}, {t.n_rows}" if t is not None else
+                f"{c.n_segments}, 0, 0, 0")
+        band, area = (t.band, t.tip_area) if t is not None else (0.0, 0.0)
+        out.append(
+            f"static const model_geometry {name} = {{\n    {head},\n"
+            f"    {c_double(max(g.chord, 1e-300))}, {c_double(band)}, {c_double(area)},\n"
+            f"    {ref(('SEG_LEN', 'SEG_K', 'G_OFF', 'SHARE', 'COLS', 'BLADE_OF', 'POINT_ROW'))},\n"
+            f"    {ref(('G', 'A', 'B', 'S', 'POINTS', 'NORMALS', 'TANGENTS'))}\n}};\n"
+            f"#define MODEL_{name} (&{name})\n")
     return "\n".join(out)
 
 
 def model_data(model, variables) -> str:
     """The contact model's part of model_data.c: where the kernel's outputs go, the structure's matrices and the
-    contact geometry's ingredients (an imported blade: its 3D tip's arrays, the Omega^4 term, and the block layout
-    the time step takes from the library's BLOCK_MIN_DOFS on)."""
+    contact geometry's ingredients (the geometries the kernel cannot build, an imported tip's or an FE casing's;
+    the Omega^4 term; the block layout the time step takes from the library's BLOCK_MIN_DOFS on)."""
     from rotorub_model import kernel
     from rotorub_model.analyses.transient import BLOCK_MIN_DOFS
     from rotorub_model.contact.geometry import geometry_spec
@@ -110,6 +128,7 @@ def model_data(model, variables) -> str:
     index += [vr[g] for g in kernel.OUT_GLOBAL_NAMES]
     spec = geometry_spec(model, 2, 0.0, 0.0, True)
     theta = next(v.start for v in variables if v.name == "theta")
+    chord = next(v.start for v in variables if v.name == "chord")
     # the step by blocks where the library's CentralDifference takes it (the same dof count, the same layout)
     layout = model.block_layout if model.n_dofs >= BLOCK_MIN_DOFS else None
     blocks = layout or (0, 0, 0, 0)
@@ -124,7 +143,7 @@ def model_data(model, variables) -> str:
     for key in ("M", "D", "K", "G1", "C1", "N2", "S2", "f_unit"):
         out.append(c_array(key, getattr(model, key).ravel()))
     out.append(c_array("S4", model.S4.ravel()) if model.S4 is not None else "#define S4 0\n")
-    out.append(tip_data(model, theta))
+    out.append(geometry_data(model, theta, chord))
     out.append(c_array("PSI_TIP", spec["psi_tip"]))
     out.append(c_array("MODES", spec["modes"], "int"))
     out.append(c_array("T_DISK", spec["T"].ravel()))
@@ -136,7 +155,7 @@ def model_data(model, variables) -> str:
         f"    {c_double(spec['r_tip'])}, {c_double(spec['stagger'])}, {c_double(spec['z_cg'])},\n"
         f"    {spec['blade_dof0']}, {spec['n_ritz']}, {spec['casing_dof0']}, {len(spec['modes'])},\n"
         "    PSI_TIP, MODES, T_DISK, R_DISK,\n"
-        f"    S4, {blocks[0]}, {blocks[1]}, {blocks[2]}, {blocks[3]}, MODEL_TIP\n}};\n")
+        f"    S4, {blocks[0]}, {blocks[1]}, {blocks[2]}, {blocks[3]}, MODEL_GEO2D, MODEL_GEO3D\n}};\n")
     return "\n".join(out)
 
 

@@ -85,6 +85,7 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
     const model_data *d = &MODEL_DATA;
     model_runtime *m;
     rr_geometry_spec spec;
+    const model_geometry *bg;
     int n = d->n, nb = d->nb, np, P;
     size_t nn = (size_t)n * n, off = 0;
     double *g;
@@ -105,9 +106,11 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
     m->nb = nb;
     m->np = np = m->formulation == FORMULATION_3D ? 2 : 1;
     P = np;
-    /* an imported blade's 3D tip: its segments are the kernel's 'blades', its stations the liner's rows */
-    m->nk = np == 2 && d->tip ? d->tip->nseg : nb;
-    m->rows = np == 2 && d->tip ? d->tip->n_rows : np;
+    /* a geometry built in (an imported tip: its segments are the kernel's 'blades', its stations the liner's rows;
+     * an FE casing's modes facing the built-in blades) */
+    bg = np == 2 ? d->geo3d : d->geo2d;
+    m->nk = bg ? bg->nb : nb;
+    m->rows = bg && bg->n_rows > 0 ? bg->n_rows : np;
     m->g0 = v->r[VR_G0];
     m->k_r = v->r[VR_K_R];
     m->mu = v->r[VR_MU];
@@ -190,9 +193,9 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
     m->contact.tangents = m->geo.tangents;
     m->contact.T2 = m->geo.T2;
     m->contact.work = m->cwork;
-    if (np == 2 && d->tip) { /* the imported tip's arrays, the library's own (built at the file's cone angle) */
-        const model_tip *tp = d->tip;
-        m->contact.nb = tp->nseg;
+    if (bg) { /* the library's own arrays (built at the parameter file's cone angle and chord) */
+        const model_geometry *tp = bg;
+        m->contact.nb = tp->nb;
         m->contact.chord = tp->chord;
         m->contact.G = tp->G;
         m->contact.A = tp->A;
@@ -284,9 +287,9 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
         m->surf.yield_force = v->r[VR_YIELD_FORCE];
         m->surf.hardening = v->r[VR_HARDENING];
         m->surf.thickness = v->r[VR_LINER_THICKNESS];
-        if (np == 2 && d->tip) { /* an imported tip: its own axial extent and footprint (Liner.for_model's) */
-            m->cell_area = d->r_tip * (6.283185307179586476925286766559 / ns) * d->tip->band;
-            m->surf.work_weight = m->cell_area / d->tip->tip_area;
+        if (bg && bg->band > 0.0) { /* an imported tip: its own axial extent and footprint (Liner.for_model's) */
+            m->cell_area = d->r_tip * (6.283185307179586476925286766559 / ns) * bg->band;
+            m->surf.work_weight = m->cell_area / bg->tip_area;
         } else {
             m->cell_area = d->r_tip * (6.283185307179586476925286766559 / ns) * (m->chord * rr_cos(d->stagger));
             m->surf.work_weight = m->cell_area / (BLADE_THICKNESS * m->chord);
