@@ -24,8 +24,9 @@ theta and one of the chord l_c (3D full, the other parameter at its default).
 An imported blade (``[fe_blade]``, docs/THEORY.md 9) is mapped with its own tip: the 3D closures come
 from its chord stations (contact/fe_tip.py). The degraded variants and the chord sweep are the paper's
 study of its beam blade (a chord and kinematics the beam's parameters set, which an FE blade has in its
-mesh): they are left out, and the summary says so (``skipped``); the cone-angle sweep stays (a casing of
-another cone facing the same tip).
+mesh): they are left out, and the summary says so (``skipped``). The cone-angle sweep stays, as another study
+than the paper's: casings of other cones facing the same tip, ground to one (the paper cuts its tip to each
+cone), so its closures need not grow with theta (paper fact 4 is not checked on an imported blade).
 
 Speed grid: a uniform grid plus the critical speeds of the imbalance response
 (:func:`rotorub_model.analyses.linear.run_response`, refined peaks) inserted exactly, plus a
@@ -525,18 +526,11 @@ def paper_facts(s: dict) -> list[dict]:
         ),
     }
     th, ch = s["theta_sweep_detail"], s["chord_sweep_detail"]
-    if ch is None:  # an imported blade: no degraded variants, no chord sweep (the paper's beam study)
-        f4 = {
-            "id": 4,
-            "statement": "the sweep theta = 0..30 deg widens the 3D detection area (an imported blade: its chord is "
-            "its tip's own, so the chord sweep is not run)",
-            "paper": {"defaults": {"theta_deg": 5.0}},
-            "ours": {"defaults": s["defaults_3d"], "theta_sweep_max_mm": s["theta_sweep"],
-                     "theta_range_mm": th["range_mm"], "theta_area_monotone": th["area_monotone"],
-                     "theta_nested_every_speed": th["nested_every_speed"]},
-            "holds": bool(th["area_monotone"] and th["max_monotone"]),
-        }
-        return [f2, f4]
+    if ch is None:
+        # an imported blade: the degraded variants and the chord sweep are not run, and its theta sweep is another
+        # study than the paper's (a tip ground to one cone facing casings of other cones, not a tip cut to each):
+        # fact 2 only
+        return [f2]
     kin, geo = s["closure_diff_kinematics_only_mm"], s["closure_diff_geometry_only_mm"]
     f3 = {
         "id": 3,

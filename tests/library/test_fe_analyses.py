@@ -14,7 +14,7 @@ import pytest
 
 from rotorub_model.analyses.continuation.branch import continue_static
 from rotorub_model.analyses.continuation.equilibria import Equilibria
-from rotorub_model.analyses.detection import run_detection
+from rotorub_model.analyses.detection import paper_facts, run_detection
 from rotorub_model.analyses.linear import _free_modes, first_order, run_campbell, run_modes
 from rotorub_model.analyses.maps import ContactSetStarts, map_row
 from rotorub_model.analyses.stability import stability_of
@@ -102,6 +102,7 @@ def test_detection_uses_the_imported_tip_and_skips_the_beam_studies(model, tmp_p
     assert sorted(p.name for p in tmp_path.glob("*.png")) == ["detection_2d_3d.png", "detection_theta.png"]
     assert s["closure_3d_max_mm"] > s["closure_2d_max_mm"] > 1.0  # the tilt and the flexure add to the disk's orbit
     assert s["defaults_3d"]["chord"] == pytest.approx(make_contact(model, "3D").geometry.chord)
+    assert [f["id"] for f in paper_facts(s)] == [2]  # the beam studies' facts (3, 4) are not claimed
     c = make_contact(model, "3D")
     q = np.linalg.solve(model.K_omega(w(model)), model.force(w(model)))
     i = int(np.argmin(np.abs(det.speeds - SPEED)))
@@ -190,3 +191,16 @@ def test_saved_model_keeps_the_imported_blade(model, tmp_path):
     for k in ("G", "A", "B", "S", "points", "normals"):
         assert np.array_equal(getattr(a, k), getattr(b, k)), k
     assert np.array_equal(a.tips.g_off, b.tips.g_off) and a.tips.tip_area == b.tips.tip_area
+
+
+def test_the_report_says_which_blade(model):
+    """The main job's summary and report on an imported blade: its superelement, dofs and frequencies, in place of
+    the built-in blades' Ritz study."""
+    from rotorub_model.app.report import _imported_blade_section
+    from rotorub_model.app.reproduce import imported_blade_summary
+
+    d = imported_blade_summary(model)
+    assert d["dofs_per_blade"] == 14 and d["tip_stations"] == 12
+    assert d["clamped_frequencies_at_rest_hz"][0] == pytest.approx(25.85, abs=0.05)  # CalculiX: 25.849 Hz
+    text = "\n".join(_imported_blade_section(d))
+    assert "14 dofs a blade" in text and "not run on an imported blade" in text
