@@ -2,10 +2,10 @@
 
     .venv/bin/python benchmarks/bench_scale_fe.py [--dofs 50] [--counts 8 12 16 24 32] [--quick]
 
-The blade: the reference's beam blade written as an FE model (rotorub_model/fe/beam_blade.py, 120 elements) and
-reduced to ``--dofs`` modes (the condensed basis, a cut-off between the 50th and the 51st rest frequency), its tip
-twelve stations along the reference chord on the 5 deg cone (``with_chord_ends``): 11 contact segments a blade, as
-the example's. The disk: ``count`` such blades on the reference shaft and casing (n = 10 + count x dofs + 8), 3D
+The blade: the reference's beam blade written as an FE model (rotorub_model/fe/beam_blade.py, max(120, 4 x dofs)
+elements) and reduced to ``--dofs`` modes (the condensed basis, a cut-off between the dofs-th and the next rest
+frequency), its tip twelve stations along the reference chord on the 5 deg cone (``with_chord_ends``): 11 contact
+segments a blade, as the example's. The disk: ``count`` such blades on the reference shaft and casing (n = 10 + count x dofs + 8), 3D
 contact with an interference of 0.1 mm so that every blade rubs from the first step, at 3.3 omega_ref.
 
 Measured for each count, in the same run:
@@ -56,7 +56,8 @@ def make_blade(folder: Path, dofs: int) -> Path:
 
     p = reference_parameters()
     w = p.normalisation.speed_max * p.normalisation.omega_ref
-    info = write_beam_blade(p, folder, speeds=(0.0, 0.5 * w, w), n_elements=120)
+    # enough elements that the kept modes are resolved (a mode is the beam's, not the mesh's)
+    info = write_beam_blade(p, folder, speeds=(0.0, 0.5 * w, w), n_elements=max(120, 4 * dofs))
     fe = read_matrix_market(info["mass"], info["stiffness"], info["dofs"], info["coordinates"], "SI", info["speeds"],
                             mass_dofs=info["mass_dofs"])
     # the rest frequencies (M has massless slopes: the pencil (M, K), K positive definite)
