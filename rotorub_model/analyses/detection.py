@@ -348,8 +348,11 @@ class DetectionResult:
         elif study in ("theta", "chord"):
             fig, axes = plt.subplots(1, 2, figsize=(12, 4.6))
             self._draw_sweep(axes, study)
-            what = (f"cone angle θ (chord {self.defaults.get('chord', 0) * 100:g} cm)" if study == "theta"
+            what = (f"cone angle θ (chord {self.defaults.get('chord', 0) * 100:.3g} cm)" if study == "theta"
                     else f"chord l_c (θ = {self.defaults.get('theta_deg', 0):g}°)")
+            if self.skipped and study == "theta":  # an imported tip: ground to one cone, facing the others
+                what = (f"casing's cone angle θ, facing the imported tip as ground (its chord "
+                        f"{self.defaults.get('chord', 0) * 100:.3g} cm)")
             fig.suptitle(f"3D detection, sweep of the {what}")
             h, lab = axes[0].get_legend_handles_labels()
             fig.legend(h, lab, loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize=8.5, frameon=False)
