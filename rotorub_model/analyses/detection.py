@@ -21,6 +21,13 @@ Studies (one figure each): 2D vs full 3D; the degraded 3D variants vs 2D (the
 paper's Fig. 7: closure differences against speed); a sweep of the cone angle
 theta and one of the chord l_c (3D full, the other parameter at its default).
 
+An imported blade (``[fe_blade]``, docs/THEORY.md 9) is mapped with its own tip: the 3D closures come
+from its chord stations (contact/fe_tip.py). The degraded variants and the chord sweep are the paper's
+study of its beam blade (a chord and kinematics the beam's parameters set, which an FE blade has in its
+mesh): they are left out, and the summary says so (``skipped``). The cone-angle sweep stays, as another study
+than the paper's: casings of other cones facing the same tip, ground to one (the paper cuts its tip to each
+cone), so its closures need not grow with theta (paper fact 4 is not checked on an imported blade).
+
 Speed grid: a uniform grid plus the critical speeds of the imbalance response
 (:func:`rotorub_model.analyses.linear.run_response`, refined peaks) inserted exactly, plus a
 dense cluster of +-2 % around each critical, because the peaks are sharp (mode 1 is
@@ -67,6 +74,8 @@ def linear_responses(model: Model, omegas: np.ndarray, me: float | None = None) 
     """
     w = np.asarray(omegas, dtype=float)
     K = model.K[None] + (w * w)[:, None, None] * (model.S2 + model.N2)[None] + w[:, None, None] * model.C1[None]
+    if model.S4 is not None:  # an imported blade's prestress beyond the quadratic
+        K = K + ((w * w) ** 2)[:, None, None] * model.S4[None]
     me = model.params.imbalance.me if me is None else me
     F = (me * w * w)[:, None] * model.f_unit[None]
     return np.linalg.solve(K, F[..., None])[..., 0]
@@ -131,6 +140,7 @@ class DetectionResult:
     thetas_deg: tuple[float, ...]
     chords_m: tuple[float, ...]
     defaults: dict[str, float] = field(default_factory=dict)  # theta_deg, chord of the 3D full
+    skipped: dict[str, str] = field(default_factory=dict)  # study -> why it was not run (an imported blade)
 
     def map(self, label: str) -> np.ndarray:
         """Boolean map (n_speeds, n_g0): contact at (speeds[i], g0[j])."""
@@ -168,11 +178,13 @@ class DetectionResult:
         i2, i3 = int(np.argmax(c2)), int(np.argmax(c3))
         diff = c3 - c2
         variants = {
-            v: float(np.max(np.abs(self.closures[lab] - c2))) * 1e3 for v, lab in VARIANT_LABELS.items()
+            v: float(np.max(np.abs(self.closures[lab] - c2))) * 1e3 if lab in self.closures else None
+            for v, lab in VARIANT_LABELS.items()
         }
         th = self._sweep([self.theta_label(t) for t in self.thetas_deg])
-        ch = self._sweep([self.chord_label(c) for c in self.chords_m])
-        g0zero = {k: bool(np.all(self.closures[k] > 0.0)) for k in ("2D", "3D", *VARIANT_LABELS.values())}
+        ch = self._sweep([self.chord_label(c) for c in self.chords_m]) if self.chords_m else None
+        formulations = [k for k in ("2D", "3D", *VARIANT_LABELS.values()) if k in self.closures]
+        g0zero = {k: bool(np.all(self.closures[k] > 0.0)) for k in formulations}
         s: dict = {
             "closure_2d_max_mm": float(c2[i2]) * 1e3,
             "closure_3d_max_mm": float(c3[i3]) * 1e3,
@@ -198,19 +210,17 @@ class DetectionResult:
             "closure_diff_full_3d_mm": float(np.max(np.abs(diff))) * 1e3,
             "closure_diff_definition": "max over the speed grid of |closure_variant - closure_2D| [mm]",
             "theta_sweep": {f"{t:g}": m for t, m in zip(self.thetas_deg, th["max"])},
-            "chord_sweep": {f"{c * 100:g}": m for c, m in zip(self.chords_m, ch["max"])},
+            "chord_sweep": {f"{c * 100:g}": m for c, m in zip(self.chords_m, ch["max"])} if ch else None,
             "sweep_note": (
                 "theta_sweep: {theta_deg: max closure mm} at the default chord; chord_sweep: {chord_cm: max "
                 "closure mm} at the default theta; area = map area above g0 = 0 in (normalised speed x mm); "
                 "nested_every_speed: each step's closure >= the previous one's at every speed"
             ),
             "theta_sweep_detail": {**th, "theta_deg": list(self.thetas_deg)},
-            "chord_sweep_detail": {**ch, "chord_cm": [c * 100 for c in self.chords_m]},
+            "chord_sweep_detail": {**ch, "chord_cm": [c * 100 for c in self.chords_m]} if ch else None,
             "theta_sweep_range_mm": th["range_mm"],
-            "chord_sweep_range_mm": ch["range_mm"],
-            "detection_area": {
-                k: detection_area(self.speeds, self.closures[k]) for k in ("2D", "3D", *VARIANT_LABELS.values())
-            },
+            "chord_sweep_range_mm": ch["range_mm"] if ch else None,
+            "detection_area": {k: detection_area(self.speeds, self.closures[k]) for k in formulations},
             "contact_at_every_speed_at_g0_zero": bool(g0zero["2D"] and g0zero["3D"]),
             "contact_at_every_speed_at_g0_zero_by_formulation": g0zero,
             "defaults_3d": self.defaults,
@@ -219,8 +229,14 @@ class DetectionResult:
             "speed_range": [float(self.speeds[0]), float(self.speeds[-1])],
             "n_g0": int(self.g0.size),
             "g0_range_mm": [float(self.g0[0]) * 1e3, float(self.g0[-1]) * 1e3],
+            "skipped": dict(self.skipped),
         }
         return s
+
+    @property
+    def studies(self) -> tuple[str, ...]:
+        """The figures this result has: '2d_3d', 'variants', 'theta', 'chord' less what was skipped."""
+        return tuple(k for k in ("2d_3d", "variants", "theta", "chord") if k not in self.skipped)
 
     # ------------------------------------------------------------------ figures
     # Fills come from the closures (the contact set at a speed is exactly g0 < c(Omega)), not from the
@@ -298,6 +314,9 @@ class DetectionResult:
     def figure(self, study: str = "2d_3d"):
         """The figure of one study: '2d_3d', 'variants', 'theta', 'chord' (open: the caller saves or closes it)."""
         plt = pyplot()
+        if study in self.skipped:
+            raise ParameterError(f"study: '{study}' was not run ({self.skipped[study]}); accepted: "
+                                 f"{', '.join(self.studies)}")
         if study == "2d_3d":
             fig, axes = plt.subplots(1, 2, figsize=(11, 4.3), gridspec_kw={"width_ratios": [1.6, 1]})
             self._draw_2d_3d(axes[0])
@@ -347,8 +366,11 @@ class DetectionResult:
         elif study in ("theta", "chord"):
             fig, axes = plt.subplots(1, 2, figsize=(12, 4.6))
             self._draw_sweep(axes, study)
-            what = (f"cone angle θ (chord {self.defaults.get('chord', 0) * 100:g} cm)" if study == "theta"
+            what = (f"cone angle θ (chord {self.defaults.get('chord', 0) * 100:.3g} cm)" if study == "theta"
                     else f"chord l_c (θ = {self.defaults.get('theta_deg', 0):g}°)")
+            if self.skipped and study == "theta":  # an imported tip: ground to one cone, facing the others
+                what = (f"casing's cone angle θ, facing the imported tip as ground (its chord "
+                        f"{self.defaults.get('chord', 0) * 100:.3g} cm)")
             fig.suptitle(f"3D detection, sweep of the {what}")
             h, lab = axes[0].get_legend_handles_labels()
             fig.legend(h, lab, loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize=8.5, frameon=False)
@@ -358,10 +380,10 @@ class DetectionResult:
         return fig
 
     def save(self, out: str | Path) -> dict:
-        """Write detection_{2d_3d,variants,theta,chord}.png, summary.json, detection.npz into ``out``."""
+        """Write detection_{2d_3d,variants,theta,chord}.png (those run), summary.json, detection.npz into ``out``."""
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
-        for study in ("2d_3d", "variants", "theta", "chord"):
+        for study in self.studies:
             save_figure(self.figure(study), out / f"detection_{study}.png", layout=False)
         np.savez(
             out / "detection.npz",
@@ -380,12 +402,20 @@ class DetectionResult:
 # ----------------------------------------------------------------------------- driver
 
 
+IMPORTED_SKIPS = {
+    "variants": "the degraded 3D variants are the paper's study of its beam blade (theta = 0 with a 1 mm chord, or "
+                "no rotation and no blade flexure); an imported blade has its chord and kinematics in its mesh",
+    "chord": "the chord sweep varies the beam blade's contact chord; an imported blade's chord is its tip's own",
+}
+
+
 def _configurations(model: Model, thetas: tuple[float, ...], chords: tuple[float, ...]) -> list[tuple[str, dict]]:
     confs: list[tuple[str, dict]] = [
         ("2D", {"formulation": "2D"}),
         ("3D", {"formulation": "3D"}),
-        *[(lab, {"formulation": "3D", "variant": v}) for v, lab in VARIANT_LABELS.items()],
     ]
+    if model.fe_blade is None:
+        confs += [(lab, {"formulation": "3D", "variant": v}) for v, lab in VARIANT_LABELS.items()]
     confs += [(f"theta={t:g}", {"formulation": "3D", "theta_deg": float(t)}) for t in thetas]
     confs += [(f"chord={c * 100:g}", {"formulation": "3D", "chord": float(c)}) for c in chords]
     return confs
@@ -417,10 +447,13 @@ def run_detection(
     from tqdm import tqdm
 
     own = model.params.contact
+    imported = model.fe_blade is not None
     if thetas_deg is None:
         thetas_deg = tuple(sorted({*THETAS_DEG, float(own.theta_deg)}))
     if chords is None:
-        chords = tuple(sorted({*CHORDS_M, float(own.chord)}))
+        chords = () if imported else tuple(sorted({*CHORDS_M, float(own.chord)}))
+    elif imported and chords:
+        raise ParameterError(f"chords: {IMPORTED_SKIPS['chord']}; accepted with an imported blade: none")
 
     if model.params.imbalance.me == 0.0:
         raise ParameterError("imbalance.me: 0 kg m; the detection maps put the imbalance response into the gaps "
@@ -468,7 +501,9 @@ def run_detection(
         closures=closures,
         thetas_deg=tuple(float(t) for t in thetas_deg),
         chords_m=tuple(float(x) for x in chords),
-        defaults={"theta_deg": c.theta_deg, "chord": c.chord},
+        defaults={"theta_deg": c.theta_deg, "chord": c.chord if not imported else
+                  float(make_contact(model, "3D").geometry.chord)},
+        skipped=dict(IMPORTED_SKIPS) if imported else {},
     )
 
 
@@ -512,6 +547,12 @@ def paper_facts(s: dict) -> list[dict]:
         condition("3D - 2D within 0.4 mm of 1.3 mm at the first critical", d13 is not None and abs(d13 - 1.3) <= 0.4,
                   "–" if d13 is None else f"{d13:.3g} mm", ROTOR),
     ])
+    th, ch = s["theta_sweep_detail"], s["chord_sweep_detail"]
+    if ch is None:
+        # an imported blade: the degraded variants and the chord sweep are not run, and its theta sweep is another
+        # study than the paper's (a tip ground to one cone facing casings of other cones, not a tip cut to each):
+        # fact 2 only
+        return [f2]
     kin, geo = s["closure_diff_kinematics_only_mm"], s["closure_diff_geometry_only_mm"]
     full = s["closure_diff_full_3d_mm"]
     f3 = with_conditions({
@@ -526,7 +567,6 @@ def paper_facts(s: dict) -> list[dict]:
         condition("'geometry only' within 0.1 mm of 2D at every speed", geo < 0.1, f"{geo:.3g} mm", ROTOR),
         condition("the full 3D more than 0.9 mm from 2D somewhere", full > 0.9, f"{full:.3g} mm", ROTOR),
     ])
-    th, ch = s["theta_sweep_detail"], s["chord_sweep_detail"]
     f4 = with_conditions({
         "id": 4,
         "statement": "sweeps theta = 0..30 deg and l_c = 1..30 cm both widen the 3D detection area; theta matters "

@@ -202,8 +202,7 @@ def harmonic_weights(model: Model, phi: np.ndarray) -> dict[int, float]:
         m = Md[i]
         w[n] = w.get(n, 0.0) + m * abs(x + 1j * y) ** 2 / 4
         w[-n] = w.get(-n, 0.0) + m * abs(x - 1j * y) ** 2 / 4
-    p = model.params
-    N, nb = p.blades.count, p.blades.dofs
+    N, nb = model.params.blades.count, model.blade_dofs
     bl = phi[model.slices["blades"]].reshape(N, nb)
     mb = Md[model.slices["blades"]].reshape(N, nb)[0]
     coef = np.fft.fft(bl, axis=0) / N  # coef[k] multiplies exp(+i k a_j)
@@ -283,7 +282,7 @@ def _weight_columns(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray, n
         if name.endswith(".x"):
             ix.append(i)
             hn.append(int(name.split(".")[1][1:]) if name.startswith("casing.n") else 1)
-    N, nb = model.params.blades.count, model.params.blades.dofs
+    N, nb = model.params.blades.count, model.blade_dofs
     keys: dict[int, None] = {}
     for n in hn:
         keys.setdefault(n)
@@ -335,6 +334,8 @@ def _free_modes(model: Model, omegas: np.ndarray) -> list[tuple[np.ndarray, np.n
         for r, i in enumerate(which):
             K0, Ks, K1, C0, C1 = cb.parts[i]
             A[r, :, k:, :k] = -(K0 + w * w * Ks + w * K1)
+            if cb.quartic is not None:  # an imported blade's Omega^4 prestress term
+                A[r, :, k:, :k] -= (w * w) ** 2 * cb.quartic[i]
             A[r, :, k:, k:] = -(C0 + w * C1)
         lam, vec = np.linalg.eig(A)
         phi = np.einsum("nk,rskm->rsnm", cb.T[:, cb.blocks[which[0]]], vec[:, :, :k, :]) if len(which) == 1 else \

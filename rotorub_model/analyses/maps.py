@@ -31,7 +31,6 @@ cells exist inside: the paper's 3D picture of a stable band around the unstable 
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -63,17 +62,13 @@ class ContactSetStarts:
 
     def __init__(self, model: Model, base: ContactModel, omega: float):
         self.model, self.base, self.omega = model, base, omega
-        g, P = base.geometry, base.n_points
         z = np.zeros(model.n_dofs)
         J, h = [], []
         for j in range(base.n_blades):
-            rows = slice(j * P, (j + 1) * P)
-            one = dataclasses.replace(g, points=g.points[j:j + 1], normals=g.normals[j:j + 1],
-                                      tangents=g.tangents[j:j + 1], Jb=g.Jb[j:j + 1], Jc=g.Jc[j:j + 1],
-                                      G=g.G[rows], A=g.A[j:j + 1], B=g.B[j:j + 1], S=g.S[rows])
+            one = base.blade_only(j)  # an imported tip: its segments, every station in contact
             # g0 = -1 closes the blade at q = 0, where its force is -h; the law's first slope (the penalty's: a
             # bilinear law's knee makes the set's law affine only up to it, so its sets are Newton starts only)
-            c = ContactModel(base.formulation, base.variant, one, -1.0, base.k_r, base.mu, base.v_slip)
+            c = ContactModel(base.formulation, base.variant, one.geometry, -1.0, base.k_r, base.mu, base.v_slip)
             J.append(c.jacobian(z, omega))
             h.append(-c.forces(z, omega))
         self.J, self.h = np.array(J), np.array(h)
@@ -115,7 +110,8 @@ class ContactSetStarts:
                         qs[lo + k] = np.linalg.solve(A[k], b[k])
                     except np.linalg.LinAlgError:
                         regular[lo + k] = False
-        gaps = self.base.with_clearance(g0).gaps_batch(qs)  # (sets, N, P)
+        c = self.base.with_clearance(g0)
+        gaps = c.by_blade(c.gaps_batch(qs))  # (sets, N, points of a blade)
         inside = member > 0
         closed = (gaps < GAP_TOL).all(axis=2)
         free = (gaps > -GAP_TOL).all(axis=2)

@@ -94,11 +94,15 @@ class CentralDifference:
     ----------
     dt : float or None
         Time step; None = half the stability limit at the largest speed seen so far.
+    dt_limit : float or None
+        The stability limit when the caller knows it (e.g. from a model that differs only by its blade count:
+        the limit is the blade's and the contact's, not the count's); None: computed here by the kernel's dense
+        eigen-solve (rr_critical_step, O(n^3): what the FMUs compute too).
     """
 
     def __init__(self, model: Model, contact: ContactModel, dt: float | None = None, t_ramp: float = 1.0,
                  max_penetration: float | None = None, omega_max_for_dt: float | None = None,
-                 liner: Liner | None = None, blocks: bool | None = None):
+                 liner: Liner | None = None, blocks: bool | None = None, dt_limit: float | None = None):
         if t_ramp is None or not math.isfinite(t_ramp) or t_ramp < 0:
             raise ParameterError(f"t_ramp: {t_ramp} out of range; accepted range [0, inf) s")
         if max_penetration is None:  # the parameter file's (contact.max_penetration: an abradable liner's depth)
@@ -112,7 +116,9 @@ class CentralDifference:
         self.blocks = (model.n_dofs >= BLOCK_MIN_DOFS) if blocks is None else bool(blocks)
         self.user_dt = dt
         w = omega_max_for_dt if omega_max_for_dt is not None else 0.0
-        self.dt_limit = critical_time_step(model, contact, w)
+        if dt_limit is not None and not (math.isfinite(dt_limit) and dt_limit > 0):
+            raise ParameterError(f"dt_limit: {dt_limit} out of range; accepted range (0, inf) s")
+        self.dt_limit = critical_time_step(model, contact, w) if dt_limit is None else float(dt_limit)
         n = model.n_dofs
         self.q = np.zeros(n)
         self.q_prev = np.zeros(n)

@@ -248,6 +248,16 @@ def _discretisation_section(d: dict) -> list[str]:
     ]
 
 
+def _imported_blade_section(d: dict) -> list[str]:
+    """The imported blade ([fe_blade]) the run was made with (docs/THEORY.md 9)."""
+    f0 = ", ".join(f"{x:.4g}" for x in d["clamped_frequencies_at_rest_hz"])
+    ft = ", ".join(f"{x:.4g}" for x in d["clamped_frequencies_at_top_speed_hz"])
+    return ["", "## The imported blade", "",
+            f"Superelement `{d['superelement']}`: {d['dofs_per_blade']} dofs a blade, {d['mass_kg']:.4g} kg; its tip "
+            f"{d['tip_stations']} chord stations over {1e3 * d['tip_chord_m']:.4g} mm. Clamped frequencies [Hz] at "
+            f"rest: {f0}; at {d['top_speed_rad_s']:.4g} rad/s: {ft}. {d['note'][0].upper()}{d['note'][1:]}."]
+
+
 def write_report(out: str | Path, summary: dict, sections: tuple[str, ...] | list[str] = ()) -> Path:
     """Write out/report.md from the main job's summary (figures by relative path); ``sections``: markdown another
     package's part of the job wrote about its own results (the FMU half's), inserted as it is before the figures."""
@@ -294,6 +304,8 @@ def write_report(out: str | Path, summary: dict, sections: tuple[str, ...] | lis
     for rel in summary.get("report_sections", []):  # sections the library's quick studies wrote next to their files
         if (out / rel).is_file():
             lines += ["", *(out / rel).read_text().rstrip("\n").split("\n")]
+    if "imported_blade" in summary:
+        lines += _imported_blade_section(summary["imported_blade"])
     for section in sections:
         lines += section.rstrip("\n").split("\n")
     lines += ["", "## Figures", ""]

@@ -146,6 +146,39 @@ class ContactModel:
         """Number of outputs of a state (the kernel's layout, rotorub_kernel.h)."""
         return kernel.OUT_BLADE_BLOCKS * self.n_blades + kernel.OUT_GLOBALS
 
+    def by_blade(self, a: np.ndarray) -> np.ndarray:
+        """Per-point values (..., n_segments, n_points) regrouped per reported blade: (..., n_blades, points of a
+        blade) (the built-in blades: as they are; an imported tip: its segments' points, leading edge first)."""
+        a = np.asarray(a)
+        if self.geometry.tips is None:
+            return a
+        return a.reshape(*a.shape[:-2], self.n_blades, -1)
+
+    def blade_only(self, j: int) -> ContactModel:
+        """The same contact restricted to blade j (its tip's segments for an imported blade; its points for the
+        built-in ones): what a contact set's law is assembled from, blade by blade."""
+        import dataclasses
+
+        g = self.geometry
+        t = g.tips
+        if t is None:
+            P = self.n_points
+            rows = slice(j * P, (j + 1) * P)
+            one = dataclasses.replace(g, points=g.points[j:j + 1], normals=g.normals[j:j + 1],
+                                      tangents=g.tangents[j:j + 1], Jb=g.Jb[j:j + 1], Jc=g.Jc[j:j + 1],
+                                      G=g.G[rows], A=g.A[j:j + 1], B=g.B[j:j + 1], S=g.S[rows])
+        else:
+            seg = np.flatnonzero(t.blade_of == j)
+            pts = (2 * seg[:, None] + np.arange(2)).ravel()  # its segments' two points each
+            tips = dataclasses.replace(t, n_blades=1, seg_len=t.seg_len[seg], seg_k=t.seg_k[seg], g_off=t.g_off[pts],
+                                       cols=t.cols[seg], blade_of=np.zeros(seg.size, dtype=np.intc),
+                                       point_row=t.point_row[pts], point_share=t.point_share[pts])
+            one = dataclasses.replace(g, points=g.points[seg], normals=g.normals[seg], tangents=g.tangents[seg],
+                                      Jb=g.Jb[seg], Jc=g.Jc[seg], G=g.G[pts], A=g.A[seg], B=g.B[seg], S=g.S[pts],
+                                      tips=tips)
+        return ContactModel(self.formulation, self.variant, one, self.g0, self.k_r, self.mu, self.v_slip, self.law,
+                            self.law_params)
+
     def with_clearance(self, g0: float) -> ContactModel:
         """Same geometry, another nominal clearance (cheap: gaps are affine)."""
         return ContactModel(self.formulation, self.variant, self.geometry, g0, self.k_r, self.mu, self.v_slip,
@@ -401,4 +434,8 @@ def make_contact(model: Model, formulation: str = "3D", variant: str = "full", *
         if variant == "kinematics_only":
             theta, chord = 0.0, 1e-3
         geo = geometry_3d(model, theta, chord, rotations=variant != "geometry_only")
+    if getattr(model, "casing_ratios", None) is not None and geo.tips is None:  # an FE casing's modes
+        from .geometry import with_fe_casing
+
+        geo = with_fe_casing(model, geo)
     return ContactModel(formulation, variant, geo, c.g0, c.k_r, c.mu, c.slip_velocity, c.law, c.law_params)

@@ -10,10 +10,10 @@ evenly carries k_r times its penetration, as the built-in blades), and friction 
 of docs/THEORY.md §4 holds station by station: the leading edge, the trailing edge and every station between.
 
 The casing: a cone of half-angle theta whose line passes at g0 from the tip's tightest station (g0 is the tip's
-clearance, wherever along the chord it is smallest); a station at radius r and axial position z from the tip's
-mean axial position has the rest gap g0 + (R - z tan theta - r) cos theta - min over the stations of the same
-(a tip not cut to the casing's line keeps its own gaps: a flat-cut tip, whose ends reach further out than its
-middle, is tightest at its ends). The normal,
+clearance, wherever along the chord it is smallest); a node at radius r and axial position z from the tip's
+mean axial position has the rest gap g0 + (R - z tan theta - r) cos theta - min over the stations of the same,
+a station the mean of its nodes' (a tip not cut to the casing's line keeps its own gaps: a flat-cut tip facing a
+5 deg cone touches at its trailing edge only). The normal,
 the sliding direction and the casing's point maps (translation, tilt about its centre of gravity, ring) are the
 built-in formulation's at each station.
 
@@ -26,12 +26,19 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..structure.casing import casing_point_map
 from ..structure.model import Model
 from .geometry import ContactGeometry, TipLayout
 
 SAME_STATION = 1e-3  # nodes closer than this fraction of the chord along it are one station
 DEFAULT_STATIONS = 12  # at most this many stations by default (more: finer, the segments' count)
+
+
+def tip_thickness(positions: np.ndarray) -> float:
+    """The tip's thickness [m]: the spread of its nodes across the chord (in the tip plane y, z; 0 for a tip
+    given as one line of nodes)."""
+    yz = positions[:, 1:] - positions[:, 1:].mean(axis=0)
+    _, _, vt = np.linalg.svd(yz, full_matrices=False)
+    return float(np.ptp(yz @ vt[1])) if vt.shape[0] > 1 else 0.0
 
 
 def stations(positions: np.ndarray, max_stations: int = DEFAULT_STATIONS) -> tuple[np.ndarray, np.ndarray, float]:
@@ -65,10 +72,36 @@ def stations(positions: np.ndarray, max_stations: int = DEFAULT_STATIONS) -> tup
     return members, station_c, chord
 
 
+def tip_node_maps(p, blade) -> tuple[np.ndarray, np.ndarray]:
+    """(points (N, n_t, 3), Jb (N, n_t, 3, n)): every tip node's rest position in the rotating frame (origin at
+    the fan disk's centre, z axial from the disk's station) and the map from the bladed disk's dofs [shaft,
+    blades] to its displacement: t + theta x rho0 + Rz(alpha_j) (tip_recovery @ q_j). ``blade``: anything with
+    ``tip_positions`` (n_t, 3), ``tip_recovery`` (n_t, 3, m) and ``m`` (a ReducedBlade, or a saved model's
+    :class:`~rotorub_model.structure.model.ImportedTip`); numpy only (the pythonfmu FMU's host has no scipy)."""
+    from ..structure.shaft import station_maps
+
+    ns = 2 * p.shaft.n_ritz
+    m = blade.m
+    N = p.blades.count
+    n = ns + N * m
+    T, Rm = station_maps(p, p.fan_disk.z)
+    nt = blade.tip_positions.shape[0]
+    points = np.zeros((N, nt, 3))
+    Jb = np.zeros((N, nt, 3, n))
+    for j in range(N):
+        a = 2.0 * np.pi * j / N
+        c, s = np.cos(a), np.sin(a)
+        R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        for i in range(nt):
+            rho0 = R @ blade.tip_positions[i]
+            points[j, i] = rho0
+            Jb[j, i, :, :ns] = T - np.cross(rho0[:, None], Rm, axis=0)
+            Jb[j, i, :, ns + j * m:ns + (j + 1) * m] = R @ blade.tip_recovery[i]
+    return points, Jb
+
+
 def geometry_fe(model: Model, theta: float, max_stations: int = DEFAULT_STATIONS) -> ContactGeometry:
     """The 3D contact geometry of ``model``'s imported blades (``model.fe_blade``)."""
-    from ..fe.bladed_disk import tip_point_maps
-
     p, blade = model.params, model.fe_blade
     if blade is None:
         raise ValueError("geometry_fe: the model has no imported blade")
@@ -77,7 +110,7 @@ def geometry_fe(model: Model, theta: float, max_stations: int = DEFAULT_STATIONS
     K = station_c.size
     if K < 2:
         raise ValueError("an imported tip needs two chord stations or more (its nodes are all at one chord position)")
-    node_points, node_Jb = tip_point_maps(p, blade)  # (N, n_t, 3), (N, n_t, 3, n)
+    node_points, node_Jb = tip_node_maps(p, blade)  # (N, n_t, 3), (N, n_t, 3, n)
     sh, bl, cs = model.slices["shaft"], model.slices["blades"], model.slices["casing"]
     m = blade.m
     R_tip, c_th, s_th, t_th = p.blades.tip_radius, np.cos(theta), np.sin(theta), np.tan(theta)
@@ -102,8 +135,11 @@ def geometry_fe(model: Model, theta: float, max_stations: int = DEFAULT_STATIONS
                 nor[s, end] = c_th * e_rho + s_th * np.array([0.0, 0.0, 1.0])
                 tan[s, end] = [-np.sin(a), np.cos(a), 0.0]
                 Jb[s, end][:, : node_Jb.shape[-1]] = node_Jb[j, nodes].mean(axis=0)  # rotor dofs (no casing)
-                Jc[s, end][:, cs] = casing_point_map(p, Pz)
-                g_off[s, end] = (R_tip - Pz[2] * t_th - np.hypot(P[0], P[1])) * c_th
+                Jc[s, end][:, cs] = model.casing_point_map(Pz)
+                # the station's rest gap: the mean of its nodes' own (a station spanning a stretch of the chord lies
+                # inside the tip's curved line, its nodes on it)
+                X = node_points[j, nodes]
+                g_off[s, end] = np.mean((R_tip - (X[:, 2] - z_tip) * t_th - np.hypot(X[:, 0], X[:, 1])) * c_th)
     # g0 is the clearance of the tip's tightest station: the cone passes at g0 from it (a flat-cut tip, whose ends
     # reach further out than its middle, keeps the larger gaps of its middle)
     g_off -= g_off.min()
@@ -133,9 +169,14 @@ def geometry_fe(model: Model, theta: float, max_stations: int = DEFAULT_STATIONS
             share[s, 0] = (0.5 * seg[k] + (0.5 * seg[k - 1] if k > 0 else 0.0)) / L
             share[s, 1] = 0.5 * seg[k] / L if k == K - 2 else 0.0
     point_row = np.array([[k, k + 1] for _ in range(N) for k in range(K - 1)], dtype=np.intc).ravel()
+    # the liner's band (the tip's axial extent) and the tip's footprint (chord x thickness; a tip given as one
+    # line of nodes: the [blades] thickness)
+    band = float(np.ptp(pts[: K - 1, :, 2]))
+    thick = tip_thickness(blade.tip_positions)
+    area = L * (thick if thick > 1e-6 * L else p.blades.thickness)
     tips = TipLayout(n_blades=N, n_dofs=n, seg_len=seg_len, seg_k=seg_len / L, g_off=g_off.ravel(), cols=cols,
                      blade_of=np.repeat(np.arange(N), K - 1).astype(np.intc), n_rows=K, point_row=point_row,
-                     point_share=share.ravel())
+                     point_share=share.ravel(), band=band, tip_area=area)
     T, _ = model.disk_maps
     return ContactGeometry(points=pts, normals=nor, tangents=tan, Jb=Jb, Jc=Jc, chord=L,
                            disk=np.ascontiguousarray(T[:2]), tips=tips, **compact)

@@ -37,6 +37,8 @@ class TipLayout:
     n_rows: int  # rows of the liner's worn depth: the tip's stations
     point_row: np.ndarray  # (S*2,) intc: each point's station
     point_share: np.ndarray  # (S*2,) the liner's share of each point (its station's tributary chord; 0: a twin)
+    band: float = 0.0  # axial extent of the tip [m] (the band of the liner it sweeps)
+    tip_area: float = 0.0  # the tip's footprint on the liner [m^2]: its chord times its thickness (0: unknown)
 
 
 @dataclass
@@ -92,3 +94,26 @@ def build_geometry(model: Model, n_points: int, theta: float = 0.0, chord: float
     if lib.rr_contact_geometry(ctypes.byref(spec), ctypes.byref(geo)) != 0:
         raise ValueError(f"contact geometry: invalid specification (points {P}, chord {chord!r} m)")
     return ContactGeometry(chord=float(chord if P == 2 else 0.0), **out)
+
+
+def with_fe_casing(model: Model, geo: ContactGeometry) -> ContactGeometry:
+    """The built-in blades' geometry (the kernel's, which knows the thin ring's modes) facing an FE casing's modes
+    (``model.casing_ratios``: each mode's tangential and axial ratios in place of the ring's -1/n and 0): the casing
+    point maps Jc again from :meth:`Model.casing_point_map`, and the rows G, S, A, B from them, as the kernel forms
+    them (docs/THEORY.md 4, 9.6)."""
+    import dataclasses
+
+    N, P = geo.points.shape[:2]
+    modes = slice(model.slices["casing"].start + 4, model.slices["casing"].stop)  # after translation and tilt
+    Jc = geo.Jc.copy()
+    for j in range(N):
+        for k in range(P):  # the modes' columns only: the rigid casing's are the kernel's (2D: no tilt)
+            Jc[j, k][:, modes] = model.casing_point_map(geo.points[j, k])[:, 4:]
+    rel = geo.Jb - Jc
+    G = -np.einsum("jpi,jpin->jpn", geo.normals, rel)
+    S = np.einsum("jpi,jpin->jpn", geo.tangents, rel).reshape(N * P, -1)
+    if P == 1:
+        A, B = G[:, 0].copy(), np.zeros_like(G[:, 0])
+    else:
+        A, B = 0.5 * (G[:, 0] + G[:, 1]), (G[:, 1] - G[:, 0]) / geo.chord
+    return dataclasses.replace(geo, Jc=Jc, G=G.reshape(N * P, -1), S=S, A=A, B=B)

@@ -92,7 +92,11 @@ class Liner:
         kw = {"yield_force": a.yield_force, "hardening": a.hardening, "thickness": a.thickness,
               "n_sectors": a.n_sectors, "radius": p.blades.tip_radius,
               "band": p.contact.chord * math.cos(math.radians(p.blades.stagger_deg)),
-              "tip_area": p.blades.thickness * p.contact.chord, **overrides}
+              "tip_area": p.blades.thickness * p.contact.chord}
+        t = contact.geometry.tips
+        if t is not None and t.band > 0 and t.tip_area > 0:  # an imported tip: its own extent and footprint
+            kw.update(band=t.band, tip_area=t.tip_area)
+        kw.update(overrides)
         return cls(contact, wears=a.enabled if wears is None else bool(wears), **kw)
 
     def set_inputs(self, closure: float | None = None, offset: tuple[float, float] | None = None,

@@ -17,6 +17,14 @@ Two node layouts: ``uniform`` (n elements; lumped masses rho A h, half at the en
 the root, at the built-in blade's own quadrature points and at the tip, with the built-in's point masses dm
 at the quadrature points): with ``gauss`` the mass distribution is the built-in's to rounding, so every
 rigid-body and coupling term can be compared with it exactly.
+
+The 3D contact's tip (:func:`with_chord_ends`): the built-in 3D formulation puts its two contact points at the
+ends of the tip's chord (leading and trailing edge, l_c apart along the stagger, on the casing's cone), each moving
+with the disk and with the blade's tip flap deflection (no twist: the beam has none). The imported beam's tip is
+given the same: two tip points at those positions, each with the tip node's recovery (a massless, rigid cap that
+translates with the tip node). Tying two FE nodes there to the tip node by springs does not do it: a spring
+between translations of points apart is strained by a rigid rotation of the blade (the importer refuses such a
+model: its coordinates do not fit its stiffness), and the beam has no twist dof to make the tie rigid.
 """
 
 from __future__ import annotations
@@ -28,6 +36,7 @@ import scipy.sparse as sp
 
 from ..structure.params import Parameters
 from ..structure.ritz import gauss
+from .blade import ReducedBlade
 from .matrix_market import write_matrix_market
 
 
@@ -106,3 +115,37 @@ def write_beam_blade(p: Parameters, folder: str | Path, speeds: tuple[float, ...
     return {"mass": folder / "mass.mtx", "stiffness": files, "dofs": folder / "dofs.txt",
             "mass_dofs": folder / "mass_dofs.txt", "coordinates": folder / "nodes.txt", "speeds": list(speeds),
             "axis_direction": (0.0, float(np.sin(beta)), float(np.cos(beta))), "tip_node": int(ids[-1])}
+
+
+def chord_end_points(p: Parameters, chord: float, theta_deg: float, stations: int = 2) -> np.ndarray:
+    """The built-in 3D formulation's leading- and trailing-edge rest points of blade 0 (2, 3), blade frame (e_r,
+    e_t, e_z): l_c apart along the stagger (cos(beta) e_z - sin(beta) e_t), on the cone R_tip - z tan(theta) (the
+    kernel's rr_contact_geometry, written out); ``stations`` > 2: that many points evenly between them."""
+    b = p.blades
+    beta, th = np.radians(b.stagger_deg), np.radians(theta_deg)
+    out = []
+    for c in np.linspace(-0.5 * chord, 0.5 * chord, stations):
+        P0 = np.array([b.tip_radius, -c * np.sin(beta), c * np.cos(beta)])
+        ap, z = np.arctan2(P0[1], P0[0]), P0[2]
+        rad = b.tip_radius - z * np.tan(th)
+        out.append([rad * np.cos(ap), rad * np.sin(ap), z])
+    return np.array(out)
+
+
+def with_chord_ends(blade: ReducedBlade, p: Parameters, chord: float, theta_deg: float,
+                    stations: int = 2) -> ReducedBlade:
+    """The imported beam ``blade`` (one tip node) with its tip at the built-in 3D formulation's two chord ends
+    (:func:`chord_end_points`), each with the tip node's recovery: the same two contact stations, at the same
+    places, moving as the built-in's do (module docstring); ``stations`` > 2: as many evenly along the chord."""
+    import dataclasses
+
+    if blade.tip_nodes.size != 1:
+        raise ValueError("with_chord_ends: a beam blade with one tip node")
+    k = int(stations)
+    rec = np.repeat(blade.tip_recovery, k, axis=0)
+    G = blade.tip_residual
+    res = np.kron(np.ones((k, k)), G) if G.size else G
+    cen = np.repeat(blade.tip_centrifugal, k, axis=0)
+    ids = int(blade.tip_nodes[0]) * 100 + 1 + np.arange(k)
+    return dataclasses.replace(blade, tip_nodes=ids, tip_positions=chord_end_points(p, chord, theta_deg, k),
+                               tip_recovery=rec, tip_residual=res, tip_centrifugal=cen)

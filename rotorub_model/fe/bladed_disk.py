@@ -99,20 +99,8 @@ def fe_bladed_disk_matrices(p: Parameters, blade: ReducedBlade) -> Matrices:
 def tip_point_maps(p: Parameters, blade: ReducedBlade) -> tuple[np.ndarray, np.ndarray]:
     """(points (N, n_t, 3), Jb (N, n_t, 3, n)): every tip node's rest position in the rotating frame (origin at
     the fan disk's centre, z axial from the disk's station) and the map from the bladed disk's dofs [shaft,
-    blades] to its displacement: t + theta x rho0 + Rz(alpha_j) (tip_recovery @ q_j)."""
-    ns = 2 * p.shaft.n_ritz
-    m = blade.m
-    N = p.blades.count
-    n = ns + N * m
-    T, Rm = station_maps(p, p.fan_disk.z)
-    nt = blade.tip_nodes.size
-    points = np.zeros((N, nt, 3))
-    Jb = np.zeros((N, nt, 3, n))
-    for j in range(N):
-        R = rz(2.0 * np.pi * j / N)
-        for i in range(nt):
-            rho0 = R @ blade.tip_positions[i]
-            points[j, i] = rho0
-            Jb[j, i, :, :ns] = T - np.cross(rho0[:, None], Rm, axis=0)
-            Jb[j, i, :, ns + j * m:ns + (j + 1) * m] = R @ blade.tip_recovery[i]
-    return points, Jb
+    blades] to its displacement: t + theta x rho0 + Rz(alpha_j) (tip_recovery @ q_j) (the contact's own,
+    :func:`rotorub_model.contact.fe_tip.tip_node_maps`)."""
+    from ..contact.fe_tip import tip_node_maps
+
+    return tip_node_maps(p, blade)

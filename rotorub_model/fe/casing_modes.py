@@ -17,7 +17,9 @@ rigid-body modes). :func:`fe_casing_matrices` and :func:`fe_casing_point_map` ar
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 import scipy.sparse as sp
@@ -45,6 +47,7 @@ class CasingMode:
 class FECasing:
     radius: float  # [m] of the contact circle
     modes: tuple[CasingMode, ...]
+    info: dict = field(default_factory=dict)
 
     def mode(self, n: int) -> CasingMode:
         for m in self.modes:
@@ -52,6 +55,60 @@ class FECasing:
                 return m
         raise FEImportError(f"casing: no FE mode with {n} nodal diameters; found {[m.n for m in self.modes]}")
 
+    def ratios(self, ns) -> tuple[np.ndarray, np.ndarray]:
+        """(tau, zeta) of the modes with ``ns`` nodal diameters: their tangential and axial amplitudes per unit
+        radial one on the contact circle."""
+        return (np.array([self.mode(n).tau for n in ns], dtype=float),
+                np.array([self.mode(n).zeta for n in ns], dtype=float))
+
+    def save(self, path: str | Path) -> Path:
+        """The casing's modal model as the project's file (JSON, SI; docs/THEORY.md 9.6): what a parameter file's
+        ``[fe_casing] model`` names."""
+        path = Path(path)
+        doc = {"format": CASING_FORMAT, "units": "SI", "radius": self.radius, "info": self.info,
+               "modes": [{k: getattr(m, k) for k in MODE_FIELDS} for m in self.modes]}
+        tmp = path.with_name(path.name + ".part")
+        tmp.write_text(json.dumps(doc, indent=1) + "\n")
+        tmp.replace(path)
+        return path
+
+
+CASING_FORMAT = "rotorub-casing-1"
+MODE_FIELDS = ("n", "frequency_hz", "modal_mass", "modal_stiffness", "damping_ratio", "tau", "zeta")
+
+
+def load_fe_casing(path: str | Path) -> FECasing:
+    """An FE casing's modal model written by :meth:`FECasing.save` (or by hand, to the same schema). One line
+    (FEImportError) naming the file and what is accepted when it is not one."""
+    path = Path(path)
+    if not path.is_file():
+        raise FEImportError(f"casing model: {path}: no such file")
+    try:
+        doc = json.loads(path.read_text())
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise FEImportError(f"casing model: {path}: not a JSON file ({exc}); accepted: the {CASING_FORMAT} file "
+                            "FECasing.save writes") from None
+    if not isinstance(doc, dict) or doc.get("format") != CASING_FORMAT or doc.get("units") != "SI":
+        got = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
+        raise FEImportError(f"casing model: {path}: format {got!r}; accepted: {CASING_FORMAT!r} in 'SI'")
+    modes = []
+    for i, md in enumerate(doc.get("modes") or []):
+        try:
+            vals = {k: (int(md[k]) if k == "n" else float(md[k])) for k in MODE_FIELDS}
+        except (KeyError, TypeError, ValueError) as exc:
+            raise FEImportError(f"casing model: {path}: mode {i + 1}: {exc!s} missing or not a number; accepted "
+                                f"fields: {', '.join(MODE_FIELDS)}") from None
+        if not (vals["n"] >= 2 and vals["modal_mass"] > 0 and vals["modal_stiffness"] > 0
+                and all(np.isfinite(v) for v in vals.values())):
+            raise FEImportError(f"casing model: {path}: mode {i + 1}: n >= 2, a positive modal mass and stiffness "
+                                f"expected, got {vals}")
+        modes.append(CasingMode(**vals))
+    if not modes:
+        raise FEImportError(f"casing model: {path}: no modes")
+    r = doc.get("radius")
+    if not (isinstance(r, int | float) and r > 0):
+        raise FEImportError(f"casing model: {path}: radius {r!r}; accepted: the contact circle's radius > 0 m")
+    return FECasing(radius=float(r), modes=tuple(sorted(modes, key=lambda m: m.n)), info=doc.get("info", {}))
 
 def harmonic_content(angles: np.ndarray, radial: np.ndarray, n_max: int) -> tuple[int, float, float]:
     """(n, a_c, a_s): the dominant harmonic of a radial displacement sampled at ``angles`` and its cos/sin
@@ -177,15 +234,4 @@ def fe_casing_point_map(p: Parameters, casing: FECasing, point: np.ndarray) -> n
     surface point at rest position ``point`` (rotating frame, z from the blade-tip plane)."""
     from ..structure.casing import casing_point_map
 
-    D = casing_point_map(p, point)
-    x, y, _ = point
-    alpha = np.arctan2(y, x)
-    e_r = np.array([np.cos(alpha), np.sin(alpha), 0.0])
-    e_t = np.array([-np.sin(alpha), np.cos(alpha), 0.0])
-    e_z = np.array([0.0, 0.0, 1.0])
-    for i, n in enumerate(p.casing.modes):
-        md = casing.mode(n)
-        c, s = np.cos(n * alpha), np.sin(n * alpha)
-        D[:, 4 + 2 * i] = c * e_r + md.tau * s * e_t + md.zeta * c * e_z
-        D[:, 5 + 2 * i] = s * e_r - md.tau * c * e_t + md.zeta * s * e_z
-    return D
+    return casing_point_map(p, point, *casing.ratios(p.casing.modes))

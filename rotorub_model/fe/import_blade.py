@@ -16,7 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FEImportError
-from ..results import pyplot, save_figure, write_json
+from ..plotting import pyplot, save_figure
+from ..writing import write_json
 from .blade import ReducedBlade, condensed, load_superelement, reduce_blade
 from .femodel import FEModel
 from .reduction import TWO_PI, compare_reductions, contact_stiffness, explicit_step, mac
@@ -124,7 +125,16 @@ class ImportBladeResult:
                 f"{min(self.mac_rest.min(), self.mac_top.min()):.4f}; explicit step {1e3 * self.step['step']:.3g} ms, "
                 f"set by the highest kept mode ({self.step['f_max_hz']:.4g} Hz at the top speed; the contact, "
                 f"k_r = {self.k_r:.3g} N/m through the tip's massless flexibility, shortens it by "
-                f"{100 * (1 - self.step['step'] / self.step['step_free']):.2g} %)")
+                f"{100 * (1 - self.step['step'] / self.step['step_free']):.2g} %)" + ("" if good else self._advice()))
+
+    def _advice(self) -> str:
+        """What to try when the reduction misses the FE code's frequencies by more than 0.1 %."""
+        b = self.blade
+        if b.info.get("basis") == "condensed" and len(self.errors()) > 1 and self.errors()[-1] > 1e-3:
+            return ("; the error grows with the speed: the prestressed blade's modes leave the rest modes' span "
+                    "(what the condensed basis keeps massless); --basis two-speed keeps both speeds' modes with "
+                    "their mass (exact at both, a shorter step), or accept the error if it is within your tolerance")
+        return "; raise --cutoff-hz (more modes) and compare"
 
     def summary(self) -> dict:
         b = self.blade

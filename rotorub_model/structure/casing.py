@@ -62,13 +62,16 @@ def casing_matrices(p: Parameters) -> Matrices:
     return block_diag(parts)
 
 
-def casing_point_map(p: Parameters, point: np.ndarray) -> np.ndarray:
+def casing_point_map(p: Parameters, point: np.ndarray, tau: np.ndarray | None = None,
+                     zeta: np.ndarray | None = None) -> np.ndarray:
     """Displacement of the casing inner-surface point at rest position ``point``.
 
     ``point`` = (x, y, z) in the rotating frame with z measured from the blade-tip
     plane. Returns D (3 x n_casing) with displacement = D q_casing: rigid translation,
     tilt about the casing centre of gravity (at z_cg), and ring radial u and
     inextensional tangential w at the point's angle (mid-surface values).
+    ``tau``, ``zeta``: an FE casing's tangential and axial ratios of each of p.casing.modes (per unit radial
+    amplitude, docs/THEORY.md 9.6) in place of the thin ring's -1/n and 0.
     """
     c = p.casing
     x, y, z = point
@@ -85,7 +88,12 @@ def casing_point_map(p: Parameters, point: np.ndarray) -> np.ndarray:
         D[:, col] = np.cross(theta, arm)
     for i, n in enumerate(c.modes):
         u_c, u_s = np.cos(n * alpha), np.sin(n * alpha)
-        w_c, w_s = -np.sin(n * alpha) / n, np.cos(n * alpha) / n
-        D[:, 4 + 2 * i] = u_c * e_r + w_c * e_t
-        D[:, 5 + 2 * i] = u_s * e_r + w_s * e_t
+        if tau is None:
+            w_c, w_s = -np.sin(n * alpha) / n, np.cos(n * alpha) / n
+            D[:, 4 + 2 * i] = u_c * e_r + w_c * e_t
+            D[:, 5 + 2 * i] = u_s * e_r + w_s * e_t
+        else:  # an FE casing's mode: w = tau_n A sin n(a - a0), v = zeta_n A cos n(a - a0)
+            e_z = np.array([0.0, 0.0, 1.0])
+            D[:, 4 + 2 * i] = u_c * e_r + tau[i] * u_s * e_t + zeta[i] * u_c * e_z
+            D[:, 5 + 2 * i] = u_s * e_r - tau[i] * u_c * e_t + zeta[i] * u_s * e_z
     return D

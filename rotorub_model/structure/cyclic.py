@@ -29,12 +29,14 @@ class CyclicBlocks:
     T: np.ndarray  # (n, n) unitary: q = T r, r the travelling-wave coordinates
     blocks: tuple[np.ndarray, ...]  # indices into r of each block, ascending
     # per block, M_b^-1 times (K, S2 + N2, C1, D, G1)_b: the first-order matrix at any speed W is
-    # [[0, I], [-(K + W^2 Ks + W K1), -(C0 + W C1)]] from these (analyses/linear.py)
+    # [[0, I], [-(K + W^2 Ks + W K1), -(C0 + W C1)]] from these (analyses/linear.py); an imported blade's
+    # prestress beyond the quadratic adds W^4 K4 (``quartic``, M_b^-1 S4_b; None for the built-in blades)
     parts: tuple[tuple[np.ndarray, ...], ...]
     # per block, the index of its complex-conjugate block (its own for a real one: index 0 and N/2 waves,
     # dofs without a pair): the model is real, so a block's conjugate holds the conjugate eigenvalues and
     # modes, and only one of the two needs solving
     conjugate: tuple[int, ...]
+    quartic: tuple[np.ndarray, ...] | None = None
 
 
 def wave_transform(model) -> tuple[np.ndarray, np.ndarray]:
@@ -68,6 +70,9 @@ def cyclic_blocks(model) -> CyclicBlocks:
     n = model.n_dofs
     T, conj = wave_transform(model)
     mats = (model.M, model.K, model.S2 + model.N2, model.C1, model.D, model.G1)
+    S4 = getattr(model, "S4", None)
+    if S4 is not None:
+        mats = (*mats, S4)
     coupled = np.zeros((n, n), dtype=bool)
     for X in mats:
         Y = T.conj().T @ X @ T
@@ -76,11 +81,14 @@ def cyclic_blocks(model) -> CyclicBlocks:
             coupled |= np.abs(Y) > 1e-12 * scale
     _, label = connected_components(csr_matrix(coupled | coupled.T), directed=False)
     blocks = sorted((np.flatnonzero(label == k) for k in range(label.max() + 1)), key=lambda b: (-len(b), int(b[0])))
-    parts = []
+    parts, quartic = [], []
     for b in blocks:
         Tb = T[:, b]
         Mb, *rest = (Tb.conj().T @ X @ Tb for X in mats)
         Mi = np.linalg.inv(Mb)
-        parts.append(tuple(Mi @ X for X in rest))
+        prod = [Mi @ X for X in rest]
+        parts.append(tuple(prod[:5]))
+        quartic.append(prod[5] if S4 is not None else None)
     of = {int(i): k for k, b in enumerate(blocks) for i in b}
-    return CyclicBlocks(T, tuple(blocks), tuple(parts), tuple(of[int(conj[b[0]])] for b in blocks))
+    return CyclicBlocks(T, tuple(blocks), tuple(parts), tuple(of[int(conj[b[0]])] for b in blocks),
+                        tuple(quartic) if S4 is not None else None)

@@ -16,6 +16,7 @@ Examples
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
@@ -29,6 +30,27 @@ from .casing import casing_matrices
 from .frames import MATRIX_KEYS, Matrices
 from .params import Parameters, from_dict, reference_parameters, to_dict
 from .shaft import shaft_matrices, station_maps
+
+
+@dataclass
+class ImportedTip:
+    """What the contact and the outputs need of an imported blade (its tip and its mass), as :func:`save_model`
+    keeps it: numpy only, so that a saved model (the pythonfmu FMU's) builds its contact without scipy. A
+    :class:`~rotorub_model.fe.blade.ReducedBlade` has the same fields."""
+
+    tip_nodes: np.ndarray  # (n_t,) ids
+    tip_positions: np.ndarray  # (n_t, 3) rest positions, blade frame [m]
+    tip_recovery: np.ndarray  # (n_t, 3, m) tip displacement per unit reduced coordinate
+    nodes: np.ndarray  # (N, 3) the mesh's nodes (figures, the blade's angular extent)
+    mass: float  # [kg]
+    basis_mass: np.ndarray  # (6 + m, 6 + m): the rigid block holds the first moments (the static moment)
+
+    @property
+    def m(self) -> int:
+        return int(self.tip_recovery.shape[2])
+
+
+IMPORTED_FIELDS = ("tip_nodes", "tip_positions", "tip_recovery", "nodes", "basis_mass")
 
 
 @dataclass
@@ -54,7 +76,16 @@ class Model:
     slices: dict[str, slice]
     mistuning: tuple[float, ...] | None = None  # per-blade stiffness deviations (build_model); None: tuned
     S4: np.ndarray | None = None  # Omega^4 term of an imported blade's prestressed stiffness (None: the built-in's)
-    fe_blade: object | None = None  # the imported blade (fe.blade.ReducedBlade) when [fe_blade] names one
+    # the imported blade when [fe_blade] names one: fe.blade.ReducedBlade (build_model), ImportedTip (load_model)
+    fe_blade: object | None = None
+    # an FE casing's (``[fe_casing]``) tangential and axial ratios of each of casing.modes; None: the thin ring's
+    casing_ratios: tuple[np.ndarray, np.ndarray] | None = None
+
+    def casing_point_map(self, point: np.ndarray) -> np.ndarray:
+        """3 x n_casing: the casing surface point's displacement (structure/casing.py; an FE casing's modes)."""
+        from .casing import casing_point_map
+
+        return casing_point_map(self.params, point, *(self.casing_ratios or (None, None)))
 
     @property
     def blade_dofs(self) -> int:
@@ -154,6 +185,63 @@ def _place(n: int, parts: list[tuple[Matrices, np.ndarray]]) -> dict[str, np.nda
     return out
 
 
+CASING_RADIUS_TOL = 0.1  # an FE casing's contact circle within this fraction of the tip radius (its surface or
+# mid-surface, a mesh)
+
+
+def fe_casing(p: Parameters):
+    """(the casing block, (tau, zeta) of each of casing.modes) of [fe_casing]'s modal model, its modes damped by
+    [casing].damping_ratio (as the ring's: the file's ratio is what it was written with)."""
+    from ..errors import ParameterError
+    from ..fe.casing_modes import CasingMode, FECasing, fe_casing_matrices, load_fe_casing
+
+    where = f"fe_casing.model ({Path(p.fe_casing.model).name})"
+    if not Path(p.fe_casing.model).is_file():
+        raise ParameterError(f"fe_casing.model: {p.fe_casing.model}: no such file; accepted: an FE casing's modal "
+                             "model that FECasing.save wrote (a path relative to the parameter file)")
+    cas = load_fe_casing(p.fe_casing.model)
+    have = [m.n for m in cas.modes]
+    missing = [n for n in p.casing.modes if n not in have]
+    if missing:
+        raise ParameterError(f"casing.modes: {list(p.casing.modes)} but {where} has modes of {have} nodal "
+                             f"diameters; accepted: nodal diameters among {have}")
+    R = p.blades.tip_radius
+    if not abs(cas.radius - R) <= CASING_RADIUS_TOL * R:
+        raise ParameterError(f"{where}: its contact circle has radius {cas.radius:.4g} m, the blade tips are at "
+                             f"{R:.4g} m; accepted: within {CASING_RADIUS_TOL:.0%} (a model of this casing, sampled "
+                             "where the tips meet it)")
+    damped = FECasing(cas.radius, tuple(CasingMode(**{**m.__dict__, "damping_ratio": p.casing.damping_ratio})
+                                        for m in cas.modes), cas.info)
+    return fe_casing_matrices(p, damped), damped.ratios(p.casing.modes)
+
+
+TIP_RADIUS_TOL = 0.01  # an imported tip's radius may differ from [blades]' by this fraction (its own cut, a mesh)
+
+
+def check_fits(p: Parameters, blade) -> None:
+    """One line (ParameterError) when the imported blade does not fit the parameter file's [blades]: its tip (the
+    tip nodes' median radius) not at the tip radius hub_radius + length (within TIP_RADIUS_TOL: the casing's
+    line, the 2D tip and the liner sit there), or blades.count such blades overlapping their neighbours (the
+    blade's angular extent about the spin axis, over its nodes, wider than the pitch 360 deg / count)."""
+    from ..errors import ParameterError
+
+    where = f"fe_blade.superelement ({Path(p.fe_blade.superelement).name})"
+    r = float(np.median(np.hypot(blade.tip_positions[:, 0], blade.tip_positions[:, 1])))
+    R = p.blades.tip_radius
+    if not abs(r - R) <= TIP_RADIUS_TOL * R:
+        raise ParameterError(f"{where}: its tip lies at radius {r:.4g} m but [blades] puts the tips at hub_radius + "
+                             f"length = {R:.4g} m; accepted: within {TIP_RADIUS_TOL:.0%} (set blades.hub_radius and "
+                             "blades.length to the blade's)")
+    pts = blade.nodes if blade.nodes.shape[0] > blade.tip_positions.shape[0] else blade.tip_positions
+    a = np.arctan2(pts[:, 1], pts[:, 0])
+    span = float(a.max() - a.min())
+    pitch = 2.0 * np.pi / p.blades.count
+    if span >= pitch:
+        raise ParameterError(f"blades.count: {p.blades.count} blades of {where} overlap (each spans "
+                             f"{np.degrees(span):.3g} deg about the spin axis, the pitch is {np.degrees(pitch):.3g} "
+                             f"deg); accepted: at most {int(np.floor(2.0 * np.pi / span - 1e-9))}")
+
+
 def build_model(params: Parameters | None = None, mistuning: Sequence[float] | np.ndarray | None = None) -> Model:
     """Assemble the model of ``params`` (default: the embedded reference).
 
@@ -166,7 +254,16 @@ def build_model(params: Parameters | None = None, mistuning: Sequence[float] | n
         from ..fe.blade import load_superelement
         from ..fe.bladed_disk import fe_bladed_disk_matrices
 
+        if not Path(p.fe_blade.superelement).is_file():
+            from ..errors import ParameterError
+
+            raise ParameterError(f"fe_blade.superelement: {p.fe_blade.superelement}: no such file; accepted: the "
+                                 "blade.npz rotorub import-blade wrote (a path relative to the parameter file)")
         blade = load_superelement(p.fe_blade.superelement)
+        check_fits(p, blade)
+        # the blade's damping is the parameter file's (blades.damping_ratio, modal on every kept mode at rest), as
+        # for the built-in blades: the ratio the import stored is the one it was given, kept for its report
+        blade = dataclasses.replace(blade, damping_ratio=p.blades.damping_ratio)
         bd = fe_bladed_disk_matrices(p, blade)
         delta = check_mistuning(p, mistuning)
         if delta is not None:  # blade j's stiffness and damping times 1 + delta_j, as the built-in blades'
@@ -177,7 +274,9 @@ def build_model(params: Parameters | None = None, mistuning: Sequence[float] | n
                 bd.D[sl, sl] *= 1.0 + dj
     else:
         bd = bladed_disk_matrices(p, mistuning=mistuning)
-    cs = casing_matrices(p)
+    cs, ratios = casing_matrices(p), None
+    if p.fe_casing.model:  # an FE casing's modes in place of the ring's (docs/THEORY.md 9.6)
+        cs, ratios = fe_casing(p)
     ns = len(sh.dofs)
     nbt = len(bd.dofs) - ns
     nc = len(cs.dofs)
@@ -200,6 +299,7 @@ def build_model(params: Parameters | None = None, mistuning: Sequence[float] | n
     model = Model(params=p, dofs=dofs, f_unit=np.zeros(n), f_tangential=np.zeros(n), f_euler=np.zeros(n),
                   slices=slices, mistuning=check_mistuning(p, mistuning), **mats)
     model.f_euler[slices["rotor"]] = bd.f_euler
+    model.casing_ratios = ratios
     if blade is not None:
         model.fe_blade = blade
         model.S4 = np.zeros((n, n))
@@ -231,10 +331,17 @@ def save_model(model: Model, path: str | Path) -> Path:
 
     T, R = model.disk_maps
     path = Path(path)
+    extra = {} if model.mistuning is None else {"mistuning": np.array(model.mistuning)}
+    if model.S4 is not None:
+        extra["S4"] = model.S4
+    if model.casing_ratios is not None:
+        extra["casing_tau"], extra["casing_zeta"] = model.casing_ratios
+    if model.fe_blade is not None:  # an imported blade: what its contact needs (the superelement's path may not
+        b = model.fe_blade  # exist where the saved model goes: an FMU's host)
+        extra.update({f"fe_{k}": np.asarray(getattr(b, k)) for k in IMPORTED_FIELDS}, fe_mass=np.array(b.mass))
     np.savez(path, params=json.dumps(to_dict(model.params)), dofs=np.array(model.dofs),
              slices=json.dumps({k: [s.start, s.stop] for k, s in model.slices.items()}),
-             disk_T=T, disk_R=R, **{k: getattr(model, k) for k in _ARRAYS},
-             **({} if model.mistuning is None else {"mistuning": np.array(model.mistuning)}))
+             disk_T=T, disk_R=R, **{k: getattr(model, k) for k in _ARRAYS}, **extra)
     return path
 
 
@@ -252,4 +359,10 @@ def load_model(path: str | Path, params: Parameters | None = None) -> Model:
                   mistuning=tuple(float(v) for v in d["mistuning"]) if "mistuning" in d.files else None,
                   **{k: np.array(d[k]) for k in _ARRAYS})
         m.__dict__["disk_maps"] = (np.array(d["disk_T"]), np.array(d["disk_R"]))
+        if "S4" in d.files:
+            m.S4 = np.array(d["S4"])
+        if "casing_tau" in d.files:
+            m.casing_ratios = (np.array(d["casing_tau"]), np.array(d["casing_zeta"]))
+        if "fe_tip_recovery" in d.files:
+            m.fe_blade = ImportedTip(mass=float(d["fe_mass"]), **{k: np.array(d[f"fe_{k}"]) for k in IMPORTED_FIELDS})
     return m

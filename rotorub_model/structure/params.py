@@ -222,6 +222,19 @@ class FEBladeParams:
 
 
 @dataclass(frozen=True)
+class FECasingParams:
+    """The casing's flexible modes from a finite-element modal model in place of the built-in ring's (docs/THEORY.md
+    9.6): a file that ``FECasing.save`` wrote (per nodal diameter: modal mass, stiffness and the tangential and axial
+    ratios of its shape on the contact circle). Off by default: the ring of [casing]. With it, [casing] gives the
+    rigid mass and tilt inertia, the nodal diameters kept (``modes``) and their damping ratio; the ring's own fields
+    (ring_thickness, ring_width, E, rho) are not used."""
+
+    model: str = field(default="", metadata={"doc": "path of the FE casing's modal model (.json, relative to the "
+                                                    "parameter file); empty: the built-in ring",
+                                             "path": True})
+
+
+@dataclass(frozen=True)
 class NormalisationParams:
     omega_ref: float = _f(0, lo_open=True, doc="reference angular speed for the normalised spin speed [rad/s]")
     speed_max: float = _f(0, lo_open=True, default=12.0,
@@ -244,6 +257,7 @@ class Parameters:
     normalisation: NormalisationParams
     abradable: AbradableParams = AbradableParams()
     fe_blade: FEBladeParams = FEBladeParams()
+    fe_casing: FECasingParams = FECasingParams()
 
     def replace(self, **sections: dict[str, Any]) -> Parameters:
         """Return a copy with some fields of some sections replaced, validated again.
@@ -277,8 +291,10 @@ _SECTIONS: dict[str, type] = {
     "normalisation": NormalisationParams,
     "abradable": AbradableParams,
     "fe_blade": FEBladeParams,
+    "fe_casing": FECasingParams,
 }
-_OPTIONAL_SECTIONS = {"abradable", "fe_blade"}  # may be left out of a parameter file: every field has its default
+# may be left out of a parameter file: every field has its default
+_OPTIONAL_SECTIONS = {"abradable", "fe_blade", "fe_casing"}
 _LISTS: dict[str, type] = {"bearings": BearingParams, "disks": DiskParams}
 
 
@@ -489,10 +505,11 @@ def load_parameters(path: str | Path | None = None) -> Parameters:
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"parameter file '{where}': not valid TOML ({exc})") from None
     # a superelement named relative to the parameter file: from its folder, wherever the command runs
-    fe = data.get("fe_blade") if isinstance(data, dict) else None
-    if path is not None and isinstance(fe, dict) and isinstance(fe.get("superelement"), str) and fe["superelement"]:
-        f = Path(fe["superelement"]).expanduser()
-        fe["superelement"] = str(f if f.is_absolute() else (Path(path).resolve().parent / f))
+    for section, key in (("fe_blade", "superelement"), ("fe_casing", "model")):
+        fe = data.get(section) if isinstance(data, dict) else None
+        if path is not None and isinstance(fe, dict) and isinstance(fe.get(key), str) and fe[key]:
+            f = Path(fe[key]).expanduser()
+            fe[key] = str(f if f.is_absolute() else (Path(path).resolve().parent / f))
     try:
         return from_dict(data)
     except ParameterError as exc:

@@ -164,6 +164,8 @@ class RotorubContext:
         analyses/detection.linear_responses, for both force directions at once."""
         w = self.omegas
         K = model.K[None] + (w * w)[:, None, None] * (model.S2 + model.N2)[None] + w[:, None, None] * model.C1[None]
+        if model.S4 is not None:  # an imported blade's prestress beyond the quadratic
+            K = K + ((w * w) ** 2)[:, None, None] * model.S4[None]
         F = np.stack([(w * w)[:, None] * model.f_unit[None], (w * w)[:, None] * model.f_tangential[None]], axis=-1)
         Q = np.linalg.solve(K, F)  # (S, n, 2)
         c0 = contact.with_clearance(0.0)

@@ -144,7 +144,7 @@ def mistuned_model(model: Model, delta: np.ndarray | None) -> Model:
 
     d = check_mistuning(model.params, delta)
     K, D = model.K.copy(), model.D.copy()
-    s0, nb = model.slices["blades"].start, model.params.blades.dofs
+    s0, nb = model.slices["blades"].start, model.blade_dofs
     for j, v in enumerate(d):
         sl = slice(s0 + j * nb, s0 + (j + 1) * nb)
         K[sl, sl] = (1.0 + v) * model.K[sl, sl]
@@ -153,12 +153,16 @@ def mistuned_model(model: Model, delta: np.ndarray | None) -> Model:
 
 
 def blade_tip_deflections(model: Model, Q: np.ndarray) -> np.ndarray:
-    """Each blade's elastic tip deflection |psi(l_b) . b_j| [m] (its own bending, relative to the disk) for
-    states Q (..., n): shape (..., N). What the amplification factors compare (docs/THEORY.md section 10)."""
+    """Each blade's elastic tip deflection |psi(l_b) . b_j| [m] (its own bending, relative to the disk; an
+    imported blade: the length of its tip nodes' mean displacement) for states Q (..., n): shape (..., N). What
+    the amplification factors compare (docs/THEORY.md section 10)."""
     from ..structure.blades import blade_functions
 
     p = model.params
-    psi_tip = blade_functions(p, p.blades.length)[0]  # (dofs,)
-    N, nb = p.blades.count, p.blades.dofs
+    N, nb = p.blades.count, model.blade_dofs
     b = np.asarray(Q)[..., model.slices["blades"]].reshape(*np.shape(Q)[:-1], N, nb)
+    if model.fe_blade is not None:  # an imported blade: its tip nodes' mean elastic displacement (blade frame)
+        tip = model.fe_blade.tip_recovery.mean(axis=0)  # (3, m)
+        return np.linalg.norm(b @ tip.T, axis=-1)
+    psi_tip = blade_functions(p, p.blades.length)[0]  # (dofs,)
     return np.abs(b @ psi_tip)

@@ -88,3 +88,73 @@ def test_casing_modes_refused():
         casing_from_modes([50.0], pure[None], pts, keep=(2, 3))
     cas = casing_from_modes([50.0], pure[None], pts, mass_norms=[2.0])
     assert cas.mode(2).modal_mass == pytest.approx(2.0) and cas.radius == pytest.approx(1.0)
+
+
+# ----------------------------------------------------------------------------- [fe_casing] in the model
+
+
+@pytest.fixture(scope="module")
+def thin(tmp_path_factory):
+    """The reference with a thin ring (h/R = 0.013), and the same ring as 360 FE frames through [fe_casing]."""
+    from rotorub_model.structure.model import build_model
+
+    d = tmp_path_factory.mktemp("ring")
+    p = reference_parameters().replace(casing={"ring_thickness": 0.0135})
+    f = fe_ring(p, d, 360).save(d / "casing.json")
+    return build_model(p), build_model(p.replace(fe_casing={"model": str(f)}))
+
+
+def test_saved_casing_model_round_trips(tmp_path):
+    from rotorub_model.fe.casing_modes import load_fe_casing
+
+    p = reference_parameters().replace(casing={"ring_thickness": 0.0135})
+    cas = fe_ring(p, tmp_path, 180)
+    back = load_fe_casing(cas.save(tmp_path / "c.json"))
+    assert back.radius == cas.radius and back.modes == cas.modes
+
+
+def test_fe_ring_in_the_model_gives_the_rings_results(thin):
+    """The thin ring as FE frames in place of the built-in ring (casing block, the contact's casing maps with the
+    FE tangential ratio): the contact rows to 1e-5, static solutions to 1e-5 and 2 s transients to 3e-4 of the
+    largest force, 2D and 3D (measured 6e-6 and 2e-5 to 2e-4: the frames' discretisation); the casing's damping is
+    [casing]'s."""
+    from rotorub_model.analyses.static import solve_static
+    from rotorub_model.analyses.transient import run_transient
+    from rotorub_model.contact import make_contact
+
+    ring, fe = thin
+    assert fe.casing_ratios is not None and ring.casing_ratios is None
+    assert np.abs(fe.casing_ratios[0] * np.array(fe.params.casing.modes) + 1.0).max() < 1e-4  # tau_n = -1/n
+    cs = ring.slices["casing"]
+    assert np.abs(fe.D[cs, cs] - ring.D[cs, cs]).max() <= 1e-4 * np.abs(ring.D[cs, cs]).max()
+    omega = 3.3 * ring.params.normalisation.omega_ref
+    for f in ("2D", "3D"):
+        a, b = make_contact(ring, f, g0=0.5e-3), make_contact(fe, f, g0=0.5e-3)
+        assert np.abs(a.G - b.G).max() <= 1e-12 and np.abs(a.S - b.S).max() <= 1e-5 * np.abs(a.S).max()
+        sa, sb = solve_static(ring, a, omega), solve_static(fe, b, omega)
+        assert sa.converged and sb.converged and sa.forces_N.max() > 50.0
+        assert np.abs(sa.forces_N - sb.forces_N).max() <= 1e-4 * sa.forces_N.max()
+        ta, tb = run_transient(ring, a, omega, t_end=2.0), run_transient(fe, b, omega, t_end=2.0)
+        Fa, Fb = ta.outputs["F_N"], tb.outputs["F_N"]
+        assert np.abs(Fa - Fb).max() <= 1e-3 * Fa.max(), f
+
+
+def test_fe_casing_bad_input(tmp_path):
+    """A missing file, a file of another format, nodal diameters the model has not, a circle far from the tips:
+    one line each naming the parameter or the file."""
+    from rotorub_model.errors import ParameterError
+    from rotorub_model.structure.model import build_model
+
+    p = reference_parameters().replace(casing={"ring_thickness": 0.0135})
+    good = fe_ring(p, tmp_path, 90)
+    f = good.save(tmp_path / "c.json")
+    (tmp_path / "other.json").write_text('{"format": "ansys-modes", "units": "SI"}')
+    (tmp_path / "far.json").write_text(f.read_text().replace(f'"radius": {good.radius!r}', '"radius": 2.0'))
+    for model, cls, words in (
+            (tmp_path / "none.json", ParameterError, r"fe_casing.model: .*none.json: no such file"),
+            (tmp_path / "other.json", FEImportError, r"format 'ansys-modes'; accepted: 'rotorub-casing-1' in 'SI'"),
+            (tmp_path / "far.json", ParameterError, r"its contact circle has radius 2 m, the blade tips are at 1 m")):
+        with pytest.raises(cls, match=words):
+            build_model(p.replace(fe_casing={"model": str(model)}))
+    with pytest.raises(ParameterError, match=r"casing.modes: \[2, 5\] but .* has modes of \[2, 3, 4\] nodal"):
+        build_model(p.replace(casing={"modes": [2, 5]}, fe_casing={"model": str(f)}))

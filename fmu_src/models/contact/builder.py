@@ -33,6 +33,8 @@ import tempfile
 import zipfile
 from pathlib import Path
 
+import numpy as np
+
 import rotorub_model
 
 from ...fmi.compile import NativeBuildError
@@ -65,10 +67,59 @@ def _parameters(params_file: str | Path | None, mode: str):
     return path, load_parameters(path)  # validated now, not in the master
 
 
+def geometry_data(model, theta: float, chord: float) -> str:
+    """The contact geometries built into model_data.c (``MODEL_GEO2D``, ``MODEL_GEO3D``): where the kernel's
+    rr_contact_geometry cannot build them at initialisation, the library's own arrays at cone angle ``theta``
+    [rad] and chord ``chord`` [m] (the FMU's start values, as the pythonfmu FMU hands them to the library), so that
+    the native FMU's contact is the library's to the bit: an imported blade's 3D tip (contact/fe_tip.py: its
+    segments, compact rows, rest gap offsets, the liner's rows and shares), the built-in blades facing an FE
+    casing's modes (contact/geometry.py with_fe_casing), 2D and 3D. Otherwise the null pointer."""
+    import math
+
+    from rotorub_model.contact import make_contact
+
+    out = []
+    for form in ("2D", "3D"):
+        name = f"GEO{form}"
+        if not ((form == "3D" and model.fe_blade is not None) or model.casing_ratios is not None):
+            out.append(f"#define MODEL_{name} 0\n")
+            continue
+        c = make_contact(model, form, theta_deg=math.degrees(theta), chord=chord)
+        g, t = c.geometry, c.geometry.tips
+        arrays = {"G": g.G, "A": g.A, "B": g.B, "S": g.S, "POINTS": g.points, "NORMALS": g.normals,
+                  "TANGENTS": g.tangents}
+        ints = {}
+        if t is not None:
+            arrays.update(SEG_LEN=t.seg_len, SEG_K=t.seg_k, G_OFF=t.g_off, SHARE=t.point_share)
+            ints = {"COLS": t.cols, "BLADE_OF": t.blade_of, "POINT_ROW": t.point_row}
+        for key, a in arrays.items():
+            out.append(c_array(f"{name}_{key}", np.asarray(a).ravel()))
+        for key, a in ints.items():
+            out.append(c_array(f"{name}_{key}", np.asarray(a).ravel(), "int"))
+
+        have = {*arrays, *ints}
+
+        def ref(keys: tuple[str, ...], name: str = name, have: set = have) -> str:
+            return ", ".join(f"{name}_{k}" if k in have else "0" for k in keys)
+
+        head = (f"{c.n_segments}, {t.cols.shape[1]}, {t.n_blades}, {t.n_rows}" if t is not None else
+                f"{c.n_segments}, 0, 0, 0")
+        band, area = (t.band, t.tip_area) if t is not None else (0.0, 0.0)
+        out.append(
+            f"static const model_geometry {name} = {{\n    {head},\n"
+            f"    {c_double(max(g.chord, 1e-300))}, {c_double(band)}, {c_double(area)},\n"
+            f"    {ref(('SEG_LEN', 'SEG_K', 'G_OFF', 'SHARE', 'COLS', 'BLADE_OF', 'POINT_ROW'))},\n"
+            f"    {ref(('G', 'A', 'B', 'S', 'POINTS', 'NORMALS', 'TANGENTS'))}\n}};\n"
+            f"#define MODEL_{name} (&{name})\n")
+    return "\n".join(out)
+
+
 def model_data(model, variables) -> str:
     """The contact model's part of model_data.c: where the kernel's outputs go, the structure's matrices and the
-    contact geometry's ingredients."""
+    contact geometry's ingredients (the geometries the kernel cannot build, an imported tip's or an FE casing's;
+    the Omega^4 term; the block layout the time step takes from the library's BLOCK_MIN_DOFS on)."""
     from rotorub_model import kernel
+    from rotorub_model.analyses.transient import BLOCK_MIN_DOFS
     from rotorub_model.contact.geometry import geometry_spec
 
     vr = {v.name: v.vr for v in scalars(declared(variables, ("fmi2", "native")))}
@@ -76,6 +127,11 @@ def model_data(model, variables) -> str:
     index = [vr[f"blade[{j}].{b}"] for b in kernel.OUT_BLADE_NAMES for j in range(1, nb + 1)]
     index += [vr[g] for g in kernel.OUT_GLOBAL_NAMES]
     spec = geometry_spec(model, 2, 0.0, 0.0, True)
+    theta = next(v.start for v in variables if v.name == "theta")
+    chord = next(v.start for v in variables if v.name == "chord")
+    # the step by blocks where the library's CentralDifference takes it (the same dof count, the same layout)
+    layout = model.block_layout if model.n_dofs >= BLOCK_MIN_DOFS else None
+    blocks = layout or (0, 0, 0, 0)
     # rr_surface_summary's values in the kernel's order (depth_max, ..., lobes, harmonic_1, ...)
     wear = [vr[f"wear.harmonic[{n.rpartition('_')[2]}]" if n.startswith("harmonic_") else f"wear.{n}"]
             for n in kernel.WEAR_NAMES]
@@ -86,6 +142,8 @@ def model_data(model, variables) -> str:
     ]
     for key in ("M", "D", "K", "G1", "C1", "N2", "S2", "f_unit"):
         out.append(c_array(key, getattr(model, key).ravel()))
+    out.append(c_array("S4", model.S4.ravel()) if model.S4 is not None else "#define S4 0\n")
+    out.append(geometry_data(model, theta, chord))
     out.append(c_array("PSI_TIP", spec["psi_tip"]))
     out.append(c_array("MODES", spec["modes"], "int"))
     out.append(c_array("T_DISK", spec["T"].ravel()))
@@ -96,7 +154,8 @@ def model_data(model, variables) -> str:
         "    M, D, K, G1, C1, N2, S2, f_unit,\n"
         f"    {c_double(spec['r_tip'])}, {c_double(spec['stagger'])}, {c_double(spec['z_cg'])},\n"
         f"    {spec['blade_dof0']}, {spec['n_ritz']}, {spec['casing_dof0']}, {len(spec['modes'])},\n"
-        "    PSI_TIP, MODES, T_DISK, R_DISK\n};\n")
+        "    PSI_TIP, MODES, T_DISK, R_DISK,\n"
+        f"    S4, {blocks[0]}, {blocks[1]}, {blocks[2]}, {blocks[3]}, MODEL_GEO2D, MODEL_GEO3D\n}};\n")
     return "\n".join(out)
 
 
@@ -115,7 +174,7 @@ def build_native_fmu(dest: str | Path = "fmus/native", params_file: str | Path |
 
     params_path, params = _parameters(params_file, mode)
     model = build_model(params)
-    defaults = cv.Defaults.from_parameters(params)
+    defaults = cv.Defaults.from_parameters(params, model)
     variables = cv.variables(defaults, mode)
     three = fmi == "3.0"
     facts = (f"{'FMI 3.0. ' if three else ''}Model built in from <code>{html.escape(params_path.name)}</code>; "
@@ -221,7 +280,8 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
     except NativeBuildError as exc:
         raise BuildError(str(exc)) from None
     files = _library_files()
-    variables = cv.variables(cv.Defaults.from_parameters(params), mode)
+    model = build_model(params)
+    variables = cv.variables(cv.Defaults.from_parameters(params, model), mode)
     own = scalars(declared(variables, ("fmi2", "pythonfmu")))
     h = hashlib.sha256()
     for p in [SLAVE, params_path, *files]:
@@ -250,7 +310,6 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
                 out.write_text(_check_relative_only(p, p.read_text()))
             else:
                 shutil.copy2(p, out)
-        model = build_model(params)
         save_model(model, Path(tmp) / "model.npz")
         manifest["n_dofs"] = model.n_dofs
         manifest["parameter_values"] = to_dict(params)  # read without a TOML parser (Python 3.10 has none)

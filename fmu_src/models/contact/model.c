@@ -22,6 +22,7 @@
 
 struct model_runtime {
     int formulation, mode, n, nb, np;
+    int nk, rows; /* the kernel's 'blades' (an imported tip's segments, else nb) and the liner's rows */
     double g0, k_r, mu, theta, chord, dt_max, max_pen, v_slip;
     rr_geometry geo;
     double *geo_mem, *cwork, *cache;
@@ -33,6 +34,9 @@ struct model_runtime {
     rr_cd_job job;
     double *Ainv, *K2, *Cm1, *f, *mwork;
     int *piv;
+    rr_cd_blocks blocks; /* the step by blocks (MODEL_DATA.blk_nb > 0), its store and scratch */
+    double *blk_store, *blk_work;
+    int *blk_piv;
     int have_mats;
     double mats_omega, mats_dt;
     double plan_h, plan_band, lim_band, lim;
@@ -64,6 +68,7 @@ void model_free(model_runtime *m)
     free(m->qs);
     free(m->siwork);
     free(m->surf_mem);
+    free(m->blk_store);
     free(m);
 }
 
@@ -71,7 +76,7 @@ void model_free(model_runtime *m)
 static double critical_step(model_runtime *m, double w)
 {
     const model_data *d = &MODEL_DATA;
-    rr_k_omega(m->n, d->K, d->S2, d->N2, d->C1, NULL, w, m->Kw);
+    rr_k_omega(m->n, d->K, d->S2, d->N2, d->C1, d->S4, w, m->Kw);
     return rr_critical_step(&m->contact, w, m->Minv, m->Kw, m->Aeig); /* Aeig: 4 n^2 of scratch */
 }
 
@@ -80,6 +85,7 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
     const model_data *d = &MODEL_DATA;
     model_runtime *m;
     rr_geometry_spec spec;
+    const model_geometry *bg;
     int n = d->n, nb = d->nb, np, P;
     size_t nn = (size_t)n * n, off = 0;
     double *g;
@@ -100,6 +106,11 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
     m->nb = nb;
     m->np = np = m->formulation == FORMULATION_3D ? 2 : 1;
     P = np;
+    /* a geometry built in (an imported tip: its segments are the kernel's 'blades', its stations the liner's rows;
+     * an FE casing's modes facing the built-in blades) */
+    bg = np == 2 ? d->geo3d : d->geo2d;
+    m->nk = bg ? bg->nb : nb;
+    m->rows = bg && bg->n_rows > 0 ? bg->n_rows : np;
     m->g0 = v->r[VR_G0];
     m->k_r = v->r[VR_K_R];
     m->mu = v->r[VR_MU];
@@ -112,8 +123,8 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
 
     /* contact geometry (the kernel's, from the ingredients baked at build time) */
     m->geo_mem = (double *)zalloc((size_t)nb * P * (3 * 3 + 2 * 3 * n) + 2 * (size_t)nb * P * n +
-                                      2 * (size_t)nb * n + 2 * (size_t)n + (size_t)rr_work_size(n, nb, np) +
-                                      (size_t)rr_cd_cache_size(n, nb, np),
+                                      2 * (size_t)nb * n + 2 * (size_t)n + (size_t)rr_work_size(n, m->nk, np) +
+                                      (size_t)rr_cd_cache_size(n, m->nk, np),
                                   sizeof(double));
     if (!m->geo_mem) goto oom;
     g = m->geo_mem;
@@ -128,8 +139,8 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
     TAKE(m->geo.B, (size_t)nb * n);
     TAKE(m->geo.S, (size_t)nb * P * n);
     TAKE(m->geo.T2, 2 * (size_t)n);
-    TAKE(m->cwork, (size_t)rr_work_size(n, nb, np));
-    TAKE(m->cache, (size_t)rr_cd_cache_size(n, nb, np));
+    TAKE(m->cwork, (size_t)rr_work_size(n, m->nk, np));
+    TAKE(m->cache, (size_t)rr_cd_cache_size(n, m->nk, np));
 #undef TAKE
     spec.n = n;
     spec.nb = nb;
@@ -182,6 +193,28 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
     m->contact.tangents = m->geo.tangents;
     m->contact.T2 = m->geo.T2;
     m->contact.work = m->cwork;
+    if (bg) { /* the library's own arrays (built at the parameter file's cone angle and chord) */
+        const model_geometry *tp = bg;
+        m->contact.nb = tp->nb;
+        m->contact.chord = tp->chord;
+        m->contact.G = tp->G;
+        m->contact.A = tp->A;
+        m->contact.B = tp->B;
+        m->contact.S = tp->S;
+        m->contact.points = tp->points;
+        m->contact.normals = tp->normals;
+        m->contact.tangents = tp->tangents;
+        m->contact.seg_len = tp->seg_len;
+        m->contact.seg_k = tp->seg_k;
+        m->contact.g_off = tp->g_off;
+        m->contact.nloc = tp->nloc;
+        m->contact.cols = tp->cols;
+        m->contact.nb_out = tp->nb_out;
+        m->contact.blade_of = tp->blade_of;
+        m->contact.n_rows = tp->n_rows;
+        m->contact.point_row = tp->point_row;
+        m->contact.point_share = tp->point_share;
+    }
 
     /* integrator state and step matrices */
     m->q = (double *)zalloc(2 * (size_t)n, sizeof(double));
@@ -193,6 +226,16 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
                              sizeof(double));
     m->siwork = (int *)zalloc(2 * (size_t)n, sizeof(int));
     if (!m->q || !m->Ainv || !m->piv || !m->qs || !m->siwork) goto oom;
+    if (d->blk_nb > 0) { /* the step by blocks: its store, scratch and pivots in one allocation */
+        int big = d->blk_ns > d->blk_m ? d->blk_ns : d->blk_m;
+        size_t store = (size_t)rr_cd_blocks_size(d->blk_ns, d->blk_nb, d->blk_m, d->blk_nc);
+        size_t work = (size_t)rr_cd_blocks_work_size(d->blk_ns, d->blk_m, d->blk_nc);
+        if (d->blk_nc > big) big = d->blk_nc;
+        m->blk_store = (double *)zalloc(store + work + (size_t)big, sizeof(double));
+        if (!m->blk_store) goto oom;
+        m->blk_work = m->blk_store + store;
+        m->blk_piv = (int *)(m->blk_work + work); /* big ints fit in big doubles */
+    }
     m->qp = m->q + n;
     m->K2 = m->Ainv + nn;
     m->Cm1 = m->K2 + nn;
@@ -244,12 +287,18 @@ model_runtime *model_configure(const model_values *v, double t0, char *msg, size
         m->surf.yield_force = v->r[VR_YIELD_FORCE];
         m->surf.hardening = v->r[VR_HARDENING];
         m->surf.thickness = v->r[VR_LINER_THICKNESS];
-        m->cell_area = d->r_tip * (6.283185307179586476925286766559 / ns) * (m->chord * rr_cos(d->stagger));
-        m->surf.work_weight = m->cell_area / (BLADE_THICKNESS * m->chord);
-        m->surf_mem = (double *)zalloc((size_t)rr_surface_table_size(nb, np, ns) + (size_t)np * ns, sizeof(double));
+        if (bg && bg->band > 0.0) { /* an imported tip: its own axial extent and footprint (Liner.for_model's) */
+            m->cell_area = d->r_tip * (6.283185307179586476925286766559 / ns) * bg->band;
+            m->surf.work_weight = m->cell_area / bg->tip_area;
+        } else {
+            m->cell_area = d->r_tip * (6.283185307179586476925286766559 / ns) * (m->chord * rr_cos(d->stagger));
+            m->surf.work_weight = m->cell_area / (BLADE_THICKNESS * m->chord);
+        }
+        m->surf_mem = (double *)zalloc((size_t)rr_surface_table_size(m->nk, np, ns) + (size_t)m->rows * ns,
+                                       sizeof(double));
         if (!m->surf_mem) goto oom;
         m->surf.tables = m->surf_mem;
-        m->surf.depth = m->surf_mem + rr_surface_table_size(nb, np, ns);
+        m->surf.depth = m->surf_mem + rr_surface_table_size(m->nk, np, ns);
         if (rr_surface_init(&m->contact, &m->surf) != 0) {
             snprintf(msg, len, "liner: the kernel refused its parameters (n_sectors %d, yield_force %g N, "
                      "liner_thickness %g m)", ns, m->surf.yield_force, m->surf.thickness);
@@ -371,8 +420,18 @@ static model_status transient_step(model_runtime *m, model_values *v, double w, 
     dt = h / ns;
     /* the matrices first: a step refused here leaves the state as it was (the two-step scheme untouched) */
     if (!m->have_mats || m->mats_omega != w || m->mats_dt != dt) {
-        if (rr_cd_build(n, d->M, d->D, d->K, d->G1, d->C1, d->N2, d->S2, NULL, NULL, w, 0.0, dt, m->Ainv, m->K2, m->Cm1,
-                        m->mwork, m->piv) != 0) {
+        int bad;
+        if (d->blk_nb > 0) { /* by blocks, as the library from BLOCK_MIN_DOFS dofs: a step linear in the blades */
+            bad = rr_cd_build_blocks(n, d->blk_ns, d->blk_nb, d->blk_m, d->blk_nc, d->M, d->D, d->K, d->G1, d->C1,
+                                     d->N2, d->S2, NULL, d->S4, w, 0.0, dt, m->blk_store, &m->blocks, m->blk_work,
+                                     m->blk_piv);
+            m->mats.blocks = &m->blocks;
+        } else {
+            bad = rr_cd_build(n, d->M, d->D, d->K, d->G1, d->C1, d->N2, d->S2, NULL, d->S4, w, 0.0, dt, m->Ainv, m->K2,
+                              m->Cm1, m->mwork, m->piv);
+            m->mats.blocks = NULL;
+        }
+        if (bad != 0) {
             m->have_mats = 0; /* the buffers hold a failed build */
             snprintf(msg, len, "the central-difference matrix is singular at %g rad/s, dt = %g s", w, dt);
             return MODEL_ERROR;
@@ -428,7 +487,7 @@ static model_status static_solution(model_runtime *m, model_values *v, double w,
     double rel, gmin, max_real = -HUGE_VAL;
     double *q = m->Ainv; /* the transient buffers are free in this mode: the candidate solution */
     double *J = m->K2, *A = m->Aeig, *C = m->Cm1;
-    rr_k_omega(m->n, d->K, d->S2, d->N2, d->C1, NULL, w, m->Kw);
+    rr_k_omega(m->n, d->K, d->S2, d->N2, d->C1, d->S4, w, m->Kw);
     for (i = 0; i < n; ++i) m->Fw[i] = me * w * w * d->f_unit[i];
     m->contact.g0 = m->g0 - v->r[VR_CLEARANCE_CLOSURE]; /* the engine's closure: uniform, so a balanced solution still is */
     ok = rr_static_solve(&m->contact, w, m->Kw, m->Fw, m->have_qs ? m->qs : NULL, 1e-10, 60, q, &rel, &its, m->swork,
@@ -566,7 +625,7 @@ model_status model_solve_now(model_runtime *m, model_values *v, double t, char *
 #define STATE_HEAD 15
 #define STATE_CUT ((int)(sizeof(((rr_surface *)0)->cut_inputs) / sizeof(double)))
 
-static size_t liner_cells(const model_runtime *m) { return (size_t)m->np * m->surf.n_sectors; }
+static size_t liner_cells(const model_runtime *m) { return (size_t)m->rows * m->surf.n_sectors; }
 
 size_t model_state_size(const model_runtime *m)
 {

@@ -17,6 +17,22 @@
 #define MODEL_HAS_STEP_TO_EVENT /* FMI 3.0 early return at a first contact */
 #define MODEL_HAS_TIME_ADVANCED /* a divergence reports the substep it reached */
 
+/* A contact geometry built into the FMU, the library's arrays as built at the parameter file's cone angle and
+ * chord: an imported blade's 3D tip (contact/fe_tip.py: nb segments between chord stations, each a 'blade' of the
+ * kernel with compact rows over nloc dofs, the outputs reporting nb_out blades, the liner's n_rows rows the
+ * stations), or the built-in blades facing an FE casing's modes (contact/geometry.py with_fe_casing: dense rows,
+ * nloc = 0, the other fields 0 or NULL). NULL in model_data: the kernel's rr_contact_geometry, built at
+ * initialisation from the ingredients above. */
+typedef struct {
+    int nb, nloc, nb_out, n_rows;
+    double chord;    /* the chord of the law [m] */
+    double band;     /* an imported tip: its axial extent, the band of the liner it sweeps [m] (0: chord cos stagger) */
+    double tip_area; /* an imported tip: its footprint on the liner [m^2] (0: BLADE_THICKNESS x chord) */
+    const double *seg_len, *seg_k, *g_off, *point_share;
+    const int *cols, *blade_of, *point_row;
+    const double *G, *A, *B, *S, *points, *normals, *tangents;
+} model_geometry;
+
 typedef struct {
     int n;                 /* generalised coordinates */
     int nb;                /* blades */
@@ -28,6 +44,10 @@ typedef struct {
     const double *psi_tip;
     const int *modes;
     const double *T, *Rot; /* (3, n) fan-disk translation and rotation */
+    const double *S4;      /* (n, n) an imported blade's Omega^4 prestress term, or NULL */
+    int blk_ns, blk_nb, blk_m, blk_nc; /* the time step by blocks (hub, blades, casing) when blk_nb > 0: where the
+                                        * library's CentralDifference takes it (BLOCK_MIN_DOFS), the same bits */
+    const model_geometry *geo2d, *geo3d; /* built-in geometries (an imported tip, an FE casing), or NULL */
 } model_data;
 
 extern const model_data MODEL_DATA;

@@ -46,7 +46,8 @@ RE_TOL = 1e-6  # a real part below this is a neutral mode's round-off (rotorub_m
 # depend on the folder it came from still existing (masters delete extracted FMUs)
 _LIB_MODULES = ("errors", "results", "kernel.compiler", "kernel", "structure.params", "structure.frames",
                 "structure.ritz", "structure.shaft", "structure.blades", "structure.casing", "structure.model",
-                "contact.geometry", "contact.point2d", "contact.chord3d", "contact.contact_model", "contact",
+                "contact.geometry", "contact.point2d", "contact.chord3d", "contact.fe_tip", "contact.contact_model",
+                "contact",
                 "contact.liner",
                 "analyses.linear", "analyses.transient", "analyses.static")
 
@@ -402,12 +403,15 @@ class RotorCasingContact(Fmi2Slave):
         sim = {"config": cfg, "model": model, "contact": contact, "g0": g0, "phi": 0.0, "q_static": None,
                "limit": (None, None), "plan": (None, None, 0), "transient": cfg["mode"] == "transient"}
         # the casing's surface: the liner (worn or rigid) and the engine's closure and offset; its cells' area
-        # as the native FMU computes it (tip radius x cell angle x chord cos(stagger))
+        # as the native FMU computes it (tip radius x cell angle x chord cos(stagger); an imported tip: its own
+        # axial extent and footprint)
+        tips = contact.geometry.tips
+        band, area = ((tips.band, tips.tip_area) if tips is not None else
+                      (cfg["chord"] * math.cos(math.radians(params.blades.stagger_deg)),
+                       params.blades.thickness * cfg["chord"]))
         sim["liner"] = lib.liner.Liner(contact, cfg["yield_force"], cfg["hardening"], cfg["liner_thickness"],
                                        int(cfg["n_sectors"]), wears=cfg["liner"] == "abradable",
-                                       radius=params.blades.tip_radius,
-                                       band=cfg["chord"] * math.cos(math.radians(params.blades.stagger_deg)),
-                                       tip_area=params.blades.thickness * cfg["chord"])
+                                       radius=params.blades.tip_radius, band=band, tip_area=area)
         closure, offset = self._r("clearance_closure"), (self._r("casing_offset.x"), self._r("casing_offset.y"))
         sim["liner"].set_inputs(closure, offset, self._distortion())
         surface = not sim["liner"].is_neutral

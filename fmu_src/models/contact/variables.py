@@ -97,15 +97,30 @@ class Defaults:
     law: str = "penalty"  # the parameter file's contact.law
     knee: float = 0.5e-3  # [m]
     stiffness_ratio: float = 4.0
+    # an imported blade or an FE casing: the contact geometry is built in at the file's theta and chord (fixed)
+    geometry_built_in: bool = False
 
     @classmethod
-    def from_parameters(cls, p) -> Defaults:
+    def from_parameters(cls, p, model=None) -> Defaults:
+        """From the parameter file; with ``model``, an imported blade's (``[fe_blade]``) mass and tip chord, and
+        whether the contact geometry is built in (an imported tip's stations, an FE casing's modes: at the file's
+        cone angle and chord)."""
         b = p.blades
+        moment, chord, imported = b.mass * (b.hub_radius + 0.5 * b.length), p.contact.chord, False
+        if model is not None and model.casing_ratios is not None:
+            imported = True
+        if model is not None and model.fe_blade is not None:
+            from rotorub_model.contact import make_contact
+
+            fe = model.fe_blade
+            first = fe.basis_mass[:3, 3:6]  # -m skew(x_cg): the blade's first moments about the disk's centre
+            moment = math.hypot(float(first[1, 2]), float(first[2, 0]))  # m times the centre of mass' radius
+            chord, imported = float(make_contact(model, "3D").geometry.chord), True
         # the two computed bounds are range limits (a judgement): written as a person reads them (fmi.variables.tidy)
         return cls(n_blades=b.count, blade_length=b.length, omega_ref=p.normalisation.omega_ref,
                    omega_max=tidy(p.normalisation.speed_max * p.normalisation.omega_ref), me=p.imbalance.me,
-                   me_max=tidy(b.mass * (b.hub_radius + 0.5 * b.length)), g0=p.contact.g0, k_r=p.contact.k_r,
-                   mu=p.contact.mu, theta=math.radians(p.contact.theta_deg), chord=p.contact.chord,
+                   me_max=tidy(moment), g0=p.contact.g0, k_r=p.contact.k_r,
+                   mu=p.contact.mu, theta=math.radians(p.contact.theta_deg), chord=chord, geometry_built_in=imported,
                    max_penetration=p.contact.max_penetration, slip_velocity=p.contact.slip_velocity,
                    liner=p.abradable.enabled, yield_force=p.abradable.yield_force, hardening=p.abradable.hardening,
                    liner_thickness=p.abradable.thickness, n_sectors=p.abradable.n_sectors, law=p.contact.law,
@@ -192,12 +207,18 @@ def variables(d: Defaults, mode: str = "transient") -> list[Var]:
             max=K_R_RANGE[1], nominal=d.k_r))
     add(Var("mu", "Real", "parameter", "fixed", "Coulomb friction coefficient", unit="1", start=d.mu,
             min=MU_RANGE[0], max=MU_RANGE[1], nominal=0.1))
+    built_in = (" Built in (imported blades' tips or an FE casing's modes, from finite-element models: the contact "
+                "geometry is made at the parameter file's cone angle and chord); another value needs a rebuild with "
+                "--params.")
+    theta_range, chord_range = (d.theta, d.theta), (d.chord, d.chord)
+    if not d.geometry_built_in:
+        theta_range, chord_range, built_in = THETA_RANGE, CHORD_RANGE, ""
     add(Var("theta", "Real", "parameter", "fixed",
             "Inclination of the conical casing inner surface (3D). Range 0 to 60 deg (the paper studies 0-30; the "
-            "linearised cone gap degrades towards 90)", unit="rad", display_unit="deg", start=d.theta,
-            min=THETA_RANGE[0], max=THETA_RANGE[1], nominal=0.1))
-    add(Var("chord", "Real", "parameter", "fixed", "Blade-tip chord length l_c (3D)", unit="m", display_unit="mm",
-            start=d.chord, min=CHORD_RANGE[0], max=CHORD_RANGE[1], nominal=0.2))
+            "linearised cone gap degrades towards 90)" + built_in, unit="rad", display_unit="deg", start=d.theta,
+            min=theta_range[0], max=theta_range[1], nominal=0.1))
+    add(Var("chord", "Real", "parameter", "fixed", "Blade-tip chord length l_c (3D)" + built_in,
+            unit="m", display_unit="mm", start=d.chord, min=chord_range[0], max=chord_range[1], nominal=0.2))
     add(Var("dt_max", "Real", "parameter", "fixed",
             "Upper limit of the internal time step (transient mode): a step h is done in n = ceil(h / min(dt_max, "
             "half the central-difference stability limit)) equal substeps", unit="s", display_unit="ms", start=1e-3,

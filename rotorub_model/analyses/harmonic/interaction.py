@@ -37,9 +37,10 @@ from threadpoolctl import threadpool_limits
 
 from ...contact import make_contact
 from ...errors import ParameterError
-from ...results import legend_outside, pyplot, save_figure, write_json
+from ...plotting import legend_outside, pyplot, save_figure
 from ...structure.model import Model
 from ...structure.params import to_dict
+from ...writing import write_json
 from ..linear import first_order
 from ..sweeps import run_tasks
 from .continuation import HBBranch, HBPoint, continue_hb

@@ -33,9 +33,10 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ...contact import make_contact
-from ...results import legend_outside, pyplot, save_figure, write_json
+from ...plotting import legend_outside, pyplot, save_figure
 from ...structure.model import Model, build_model
 from ...structure.params import to_dict
+from ...writing import write_json
 from .autonomous import hopf_start, newton_autonomous, section_phase, section_state, seed_from_samples
 from .continuation import continue_hb
 from .orbit import OrbitView, measures_from_states, tip_deflection
