@@ -21,9 +21,16 @@
 #include "fmi2Functions.h"
 #include "fmu_core.h"
 
+/* A host reads the same outputs after every step: the value references fmi2GetReal last validated are kept, and
+ * a call with the same list (compared element by element, not by address: the host may refill its array) skips
+ * the walk through the variable table. */
+#define REAL_MEMO 256
+
 typedef struct {
     fmu_core core; /* first: an inst_t is its core */
     fmi2CallbackFunctions cb;
+    size_t real_memo_n; /* 0: nothing validated yet */
+    fmi2ValueReference real_memo[REAL_MEMO];
 } inst_t;
 
 static const core_dialect FMI2 = {0x52524632u /* "RRF2" */, "fmi2SetFMUstate", "fmi2Reset", "fmi2Terminate",
@@ -203,8 +210,14 @@ fmi2Status fmi2GetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t
     CHECK_INSTANCE(comp, "fmi2GetReal");
     if ((s = (fmi2Status)core_check_readable(c, "fmi2GetReal")) != fmi2OK) return s;
     if (nvr && (!vr || !value)) return FAIL(comp, "fmi2GetReal: NULL array");
-    for (k = 0; k < nvr; ++k)
-        if ((s = check_vr(c, "fmi2GetReal", vr[k], 1, 0, 0)) != fmi2OK) return s;
+    if (nvr && (nvr != INST(comp)->real_memo_n || memcmp(vr, INST(comp)->real_memo, nvr * sizeof *vr) != 0)) {
+        for (k = 0; k < nvr; ++k)
+            if ((s = check_vr(c, "fmi2GetReal", vr[k], 1, 0, 0)) != fmi2OK) return s;
+        if (nvr && nvr <= REAL_MEMO) {
+            memcpy(INST(comp)->real_memo, vr, nvr * sizeof *vr);
+            INST(comp)->real_memo_n = nvr;
+        }
+    }
     if ((s = (fmi2Status)core_refresh_outputs(c)) > fmi2Warning) return s;
     for (k = 0; k < nvr; ++k) value[k] = c->r[vr[k]];
     return fmi2OK;

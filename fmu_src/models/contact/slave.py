@@ -44,7 +44,7 @@ RE_TOL = 1e-6  # a real part below this is a neutral mode's round-off (rotorub_m
 
 # submodules of the bundled library imported eagerly: a later lazy import must not
 # depend on the folder it came from still existing (masters delete extracted FMUs)
-_LIB_MODULES = ("errors", "results", "kernel.compiler", "kernel", "structure.params", "structure.frames",
+_LIB_MODULES = ("errors", "writing", "plotting", "kernel.compiler", "kernel", "structure.params", "structure.frames",
                 "structure.ritz", "structure.shaft", "structure.blades", "structure.casing", "structure.model",
                 "contact.geometry", "contact.point2d", "contact.chord3d", "contact.fe_tip", "contact.contact_model",
                 "contact",
@@ -724,7 +724,7 @@ class RotorCasingContact(Fmi2Slave):
 
     @staticmethod
     def _fmu_state_to_bytes(state) -> bytes:
-        # pythonfmu calls this without an instance, so the bundled library's results.plain
+        # pythonfmu calls this without an instance, so the bundled library's writing.plain
         # is out of reach here; this is its NumPy-to-JSON conversion for the state's types
         def plain(x):
             if isinstance(x, np.ndarray):
