@@ -97,6 +97,16 @@ class Event:
         return np.where(np.isnan(v), np.nan, hit.astype(float))
 
     @property
+    def display(self) -> str:
+        """The event as a person reads it, with its unit: "margin < 0.5 mm" for "margin < 0.5e-3"."""
+        if self.op is None:
+            return self.text
+        unit = QUANTITIES[self.quantity].unit
+        if unit == "m":
+            return f"{self.quantity} {self.op} {self.threshold * 1e3:.4g} mm"
+        return f"{self.quantity} {self.op} {self.threshold:.4g}" + ("" if unit == "-" else f" {unit}")
+
+    @property
     def limit_state(self) -> tuple[str, str, float] | None:
         """(value quantity, op, threshold) for FORM and subset sampling; None for a boolean quantity."""
         if self.op is not None:
@@ -138,3 +148,15 @@ def check_quantities(names, where: str = "study.quantities") -> list[Quantity]:
         if n not in [q.name for q in out]:
             out.append(QUANTITIES[n])
     return out
+
+
+def event_display(text: str) -> str:
+    """:attr:`Event.display` of an event's text (the text itself if it does not parse).
+
+    >>> event_display("margin < 0.5e-3"), event_display("peak_force > 500"), event_display("rub")
+    ('margin < 0.5 mm', 'peak_force > 500 N', 'rub')
+    """
+    try:
+        return parse_event(text).display
+    except ParameterError:
+        return text

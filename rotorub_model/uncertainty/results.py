@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..plotting import pyplot, save_figure
 from ..writing import write_json
-from .quantities import QUANTITIES
+from .quantities import QUANTITIES, event_display
 from .study import Study
 
 UNITS = {"m": (1e3, "mm"), "N": (1.0, "N"), "1/s": (1.0, "1/s"), "-": (1.0, "")}
@@ -106,7 +106,7 @@ class UQResult:
         lines = []
         conf = f"{100 * s.confidence:g} %"
         for text, p in e.get("probabilities", {}).items():
-            lines.append(f"P({text}) at {self.operating_text()} = {_pct(p['probability'])} "
+            lines.append(f"P({event_display(text)}) at {self.operating_text()} = {_pct(p['probability'])} "
                          f"[{_pct(p['low'])}, {_pct(p['high'])}] ({conf}; {p['points']} points)")
         g = self.clearance_for()
         if "clearance_curve" in e:
@@ -142,7 +142,7 @@ class UQResult:
         sp = e.get("small_probability")
         if sp:
             iv = f" [{_pct(sp['low'])}, {_pct(sp['high'])}]" if sp.get("low") is not None else ""
-            lines.append(f"P({sp['event']}) at {self.operating_text()} = {_pct(sp['probability'])}{iv} "
+            lines.append(f"P({event_display(sp['event'])}) at {self.operating_text()} = {_pct(sp['probability'])}{iv} "
                          f"({s.method}, {sp['evaluations']} evaluations)")
         return "; ".join(lines) if lines else "no estimate"
 

@@ -82,6 +82,11 @@ def _field_range(cls: type, name: str, where: str) -> tuple[float, float, bool]:
     raise ParameterError(f"{where}: unknown parameter; accepted fields here: {', '.join(names)}")
 
 
+# the built-in beam blade's own fields: an imported blade ([fe_blade]) takes its mass and stiffness from its
+# superelement, so a study input on one of these would silently change nothing
+BEAM_ONLY = ("width", "thickness", "E", "rho")
+
+
 def resolve_target(where: str, name: str, params: Parameters | None) -> Target:
     """The :class:`Target` named ``name`` (``where``: the study file's place, for the message)."""
     if not isinstance(name, str) or not name:
@@ -97,6 +102,11 @@ def resolve_target(where: str, name: str, params: Parameters | None) -> Target:
         raise ParameterError(f"{where}: '{name}' unknown; accepted engine inputs: {', '.join(ok)}")
     if parts[0] in _SECTIONS and len(parts) == 2:
         lo, hi, lo_open = _field_range(_SECTIONS[parts[0]], parts[1], f"{where}: '{name}'")
+        if parts[0] == "blades" and parts[1] in BEAM_ONLY and params is not None and params.fe_blade.superelement:
+            # an imported blade's mass and stiffness are its superelement's: a beam field would change nothing
+            raise ParameterError(f"{where}: '{name}' is a field of the built-in beam blade, which an imported blade "
+                                 f"([fe_blade] {params.fe_blade.superelement}) does not use; accepted for an imported "
+                                 "blade: blades.damping_ratio, or mistuning ([mistuning]) for its stiffness")
         return Target(name, lo, hi, lo_open, "param", parts[0], field=parts[1])
     if parts[0] in _LISTS and len(parts) == 3:
         items = [it.name for it in getattr(params, parts[0])] if params is not None else []

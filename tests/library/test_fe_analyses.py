@@ -22,6 +22,7 @@ from rotorub_model.analyses.static import solve_static
 from rotorub_model.analyses.transient import run_transient
 from rotorub_model.analyses.wear import run_wear
 from rotorub_model.contact import make_contact
+from rotorub_model.errors import ParameterError
 from rotorub_model.structure.model import build_model, load_model, save_model
 from rotorub_model.structure.params import load_parameters, to_dict
 from rotorub_model.uncertainty.mistuning import blade_tip_deflections, mistuned_model
@@ -85,6 +86,18 @@ def test_mistuned_disk_of_imported_blades(model):
     assert len(built.cyclic.blocks) < len(model.cyclic.blocks)
     q = np.linalg.solve(model.K_omega(w(model)), model.force(w(model)))
     assert blade_tip_deflections(model, q).shape == (10,)
+
+
+def test_a_study_input_on_a_beam_field_is_refused_for_an_imported_blade(model):
+    """blades.thickness means nothing to an imported blade (its stiffness is its superelement's): a study that varies
+    it would report a spread of zero; it is refused in one line that names the input and what is accepted."""
+    from rotorub_model.uncertainty.targets import resolve_target
+
+    with pytest.raises(ParameterError, match=r"inputs.t: 'blades.thickness' is a field of the built-in beam blade.*"
+                                             r"accepted for an imported blade: blades.damping_ratio"):
+        resolve_target("inputs.t", "blades.thickness", model.params)
+    assert resolve_target("inputs.z", "blades.damping_ratio", model.params).field == "damping_ratio"
+    assert resolve_target("inputs.t", "blades.thickness", build_model().params).field == "thickness"  # beam: fine
 
 
 def test_modes_and_campbell_are_labelled(model):
