@@ -225,7 +225,7 @@ def run_reproduce(model: Model, out: str | Path, quick: bool = False, params_fil
         cont = run_continuation_study(model, out / "continuation", maps_dir=out / "stability", quick=quick,
                                       progress=progress)
     sections = []
-    with step("forced_response", "forced response of an offset casing (harmonic balance, quick)"):
+    with step("forced_response", "forced response of an oval casing (harmonic balance, quick)"):
         from .forced_response import run_forced_quick
 
         _, md = run_forced_quick(model, out / "forced_response")

@@ -121,7 +121,7 @@ def test_main_job_reports_the_quick_forced_response_and_uncertainty(run):
     linked from the report's folder, and every stage's time is in the summary (what the main job is made of)."""
     out, summary = run
     text = (out / "report.md").read_text()
-    assert "## Forced response of an offset casing (harmonic balance)" in text
+    assert "## Forced response of an oval casing (harmonic balance)" in text
     assert "## Will it rub? Uncertainty (quick)" in text
     assert "(forced_response/interaction_map.png)" in text
     assert (out / "forced_response" / "interaction_map.png").exists()
