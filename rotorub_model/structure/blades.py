@@ -4,7 +4,8 @@ Each blade j sits at angle alpha_j = 2 pi j / N (rotating frame), is clamped at 
 hub radius r_d and bends with deflection v(s) = sum psi_k(s) b_k along its flexible
 direction n_j = cos(beta) e_t + sin(beta) e_z (beta: stagger from the axis).
 
-The functions psi_k: the ``n_ritz`` clamped-free polynomials (s/l)^(k+1) when all are kept; with
+The functions psi_k: the ``n_ritz`` clamped-free polynomials of degree 2..n_ritz+1 when all are kept (the
+paper's (s/l)^(k+1) up to three, the same space in a well-conditioned form beyond: structure/ritz.py); with
 ``n_modes < n_ritz``, a fixed-interface component-mode reduction of those polynomials (the blade root
 moves with the disk, so its rigid motion is in the kinematics already and fixed-interface modes complete
 it): the lowest cantilever modes at rest and at the top of the speed range (:func:`_two_speed_modes`).
@@ -46,7 +47,7 @@ import numpy as np
 
 from .frames import Matrices
 from .params import BladeParams, Parameters
-from .ritz import cantilever_basis, cantilever_foreshortening, gauss
+from .ritz import blade_foreshortening_polynomials, blade_polynomials, gauss
 from .shaft import station_maps
 
 Z = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
@@ -98,13 +99,13 @@ def _two_speed_modes(b: BladeParams, omega_top: float) -> np.ndarray | None:
     from scipy.linalg import eigh
 
     s, w = gauss(0.0, b.length, b.n_ritz + 8)
-    psi = cantilever_basis(s, b.length, b.n_ritz)
-    ddpsi = cantilever_basis(s, b.length, b.n_ritz, 2)
+    psi = blade_polynomials(s, b.length, b.n_ritz)
+    ddpsi = blade_polynomials(s, b.length, b.n_ritz, 2)
     dm = b.rho * b.area * w
     K = b.E * b.second_moment * (ddpsi.T * w) @ ddpsi
     M = (psi.T * dm) @ psi
     # the blade's own centrifugal stiffness (the blade-blade block of S2 + N2 in bladed_disk_matrices)
-    fs = cantilever_foreshortening(s, b.length, b.n_ritz)
+    fs = blade_foreshortening_polynomials(s, b.length, b.n_ritz)
     R = b.hub_radius + s
     KS = np.einsum("g,gkl->kl", dm * R, fs) - np.cos(np.radians(b.stagger_deg)) ** 2 * M
     n_rest = (b.n_modes + 1) // 2
@@ -112,14 +113,14 @@ def _two_speed_modes(b: BladeParams, omega_top: float) -> np.ndarray | None:
     V = np.linalg.qr(np.hstack(cols))[0]
     _, z = eigh(V.T @ K @ V, V.T @ M @ V)  # the reduced blade's modes at rest
     phi = V @ z
-    tip = cantilever_basis(b.length, b.length, b.n_ritz)[0] @ phi
+    tip = blade_polynomials(b.length, b.length, b.n_ritz)[0] @ phi
     return phi / tip
 
 
 def blade_functions(p: Parameters, s, deriv: int = 0) -> np.ndarray:
     """The kept blade functions (or their derivatives) at s, shape (len(s), p.blades.dofs)."""
     b = p.blades
-    psi = cantilever_basis(s, b.length, b.n_ritz, deriv)
+    psi = blade_polynomials(s, b.length, b.n_ritz, deriv)
     phi = blade_basis(p)
     return psi if phi is None else psi @ phi
 
@@ -127,7 +128,7 @@ def blade_functions(p: Parameters, s, deriv: int = 0) -> np.ndarray:
 def blade_foreshortening(p: Parameters, s) -> np.ndarray:
     """int_0^s psi_k' psi_m' ds' of the kept functions, shape (len(s), dofs, dofs)."""
     b = p.blades
-    fs = cantilever_foreshortening(s, b.length, b.n_ritz)
+    fs = blade_foreshortening_polynomials(s, b.length, b.n_ritz)
     phi = blade_basis(p)
     return fs if phi is None else np.einsum("ki,gkl,lm->gim", phi, fs, phi)
 
