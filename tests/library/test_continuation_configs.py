@@ -165,6 +165,7 @@ def study(tmp_path_factory):
     return run
 
 
+@pytest.mark.slow  # the first test of a configuration runs its whole study (maps, branches, curves): 20-60 s each
 @pytest.mark.parametrize("name", CONFIGURATIONS)
 def test_summary_is_written_at_the_configurations_speed(study, name):
     m, r, s, out = study(name)
@@ -289,6 +290,7 @@ def test_orbits_are_drawn_on_their_static_branch(study, name):
     assert checked >= 1  # every configuration has a 3D Hopf point with its orbits
 
 
+@pytest.mark.slow  # a 30-blade rotor's 2D quick map and boundary curves: about 20 s on 2 cores
 def test_thirty_blades_2d_boundaries_meet_at_their_corners():
     """A second newcomer's 30 blades (3 polynomials reduced to 2 modes, 78 dofs). The 2D first-contact switch stops
     being a stability boundary where the contact solution turns stable, and the boundary goes on as a curve shorter

@@ -20,7 +20,7 @@ from rotorub_model.fe.beam_blade import write_beam_blade
 from rotorub_model.fe.blade import _check_tip, _frame_of, assemble_superelement
 from rotorub_model.structure.blades import blade_tip_map, bladed_disk_matrices
 from rotorub_model.structure.params import reference_parameters
-from rotorub_model.structure.ritz import cantilever_basis
+from rotorub_model.structure.ritz import blade_polynomials
 from rotorub_model.structure.shaft import shaft_matrices, station_maps
 
 N_CONVERGED = 8  # the built-in's converged blade basis (docs/THEORY.md 3.2)
@@ -78,7 +78,8 @@ def rotor_frequencies(p, mats, omega: float, n: int = 16) -> np.ndarray:
 
 def test_coupling_terms_equal_builtin_on_the_same_basis(tmp_path):
     """With FE nodes at the built-in blade's quadrature points (its point masses) and the built-in's eight
-    polynomials as the basis, every matrix of the bladed disk but the blade's own stiffness is the built-in's
+    polynomials (its own functions, blade_polynomials) as the basis, every matrix of the bladed disk but the
+    blade's own stiffness is the built-in's
     to rounding: rigid mass and inertia, Coriolis, spin softening, the centrifugal and Euler couplings of disk
     tilt with the blade, and the blades' inertia load under angular acceleration."""
     p = undamped().replace(blades={"n_ritz": N_CONVERGED, "n_modes": N_CONVERGED})
@@ -88,8 +89,8 @@ def test_coupling_terms_equal_builtin_on_the_same_basis(tmp_path):
     frame = _frame_of(fe, (0.0, 0.0, 0.0), info["axis_direction"], None)
     tips, rows = _check_tip(fe, [info["tip_node"]])
     s = fe.coordinates_of(fe.dof_nodes)[:, 0] - p.blades.hub_radius
-    V = np.where((fe.dof_components == 2)[:, None], cantilever_basis(s, p.blades.length, N_CONVERGED),
-                 cantilever_basis(s, p.blades.length, N_CONVERGED, 1))
+    V = np.where((fe.dof_components == 2)[:, None], blade_polynomials(s, p.blades.length, N_CONVERGED),
+                 blade_polynomials(s, p.blades.length, N_CONVERGED, 1))
     blade = assemble_superelement(fe, frame, V, tips, rows, 2, True, 0.0)
     fm, bi = fe_bladed_disk_matrices(p, blade), bladed_disk_matrices(p)
     ns = 2 * p.shaft.n_ritz

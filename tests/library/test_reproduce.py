@@ -11,6 +11,7 @@ from rotorub_model.app.reproduce import run_reproduce
 from rotorub_model.structure.model import build_model
 
 
+# the main job (quick) once for the file: its fixture takes about 55 s on 2 cores, each test then reads its output
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
     out = tmp_path_factory.mktemp("reproduce")
