@@ -24,39 +24,19 @@ def _add_build_args(sp: argparse.ArgumentParser) -> None:
                          "installed, else this machine's")
 
 
-def build(dest: str | Path, params: str | Path | None = None, native: bool = False, mode: str = "transient",
-          platforms: tuple[str, ...] | None = None, fmi3: bool = False) -> dict:
-    """Build one flavour of RotorCasingContact.fmu into ``dest`` and write its cross-check kit next to it
-    (``fmi3``: the native FMI 3.0 FMU and its kit)."""
-    from rotorub_model.structure.params import load_parameters
-
-    from .fmi.compile import NativeBuildError
-    from .models.contact import crosscheck
-    from .models.contact.builder import build_fmu, build_native_fmu
-
-    if fmi3 and not native:
-        raise NativeBuildError("--fmi3: the FMI 3.0 FMU is the native one: add --native (pythonfmu 0.7 writes FMI "
-                               "2.0 only)")
-    if native:
-        out = build_native_fmu(dest, params, platforms, mode, fmi="3.0" if fmi3 else "2.0")
-    else:
-        out = build_fmu(dest, params, platforms, mode)
-    kit = crosscheck.write_kit(Path(out["fmu"]).parent, load_parameters(params) if params else None,
-                               fmi="3.0" if fmi3 else "2.0")
-    return {**out, "crosscheck_kit": sorted(str(p) for p in kit.values())}
-
-
 def _run_build(ns: argparse.Namespace) -> dict:
     from rotorub_model.errors import ParameterError
     from rotorub_model.kernel.compiler import CompilerError
 
     from .fmi.compile import NativeBuildError
     from .fmi.pythonfmu import BuildError
+    from .models.contact.builder import build_with_kit
 
     default = Path("fmus") / (("native-fmi3" if ns.fmi3 else "native") if ns.native else "")
     dest = default if ns.out == "out/build-fmu" else Path(ns.out)
     try:
-        r = build(dest, ns.params, ns.native, ns.mode, tuple(ns.platforms) if ns.platforms else None, ns.fmi3)
+        r = build_with_kit(dest, ns.params, ns.native, ns.mode, tuple(ns.platforms) if ns.platforms else None,
+                           ns.fmi3)
     except (BuildError, NativeBuildError, CompilerError) as exc:
         raise ParameterError(f"build-fmu: {exc}") from None
     plats = r.get("platforms") or r.get("kernel_platforms") or []

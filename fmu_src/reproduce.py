@@ -31,8 +31,8 @@ def build_all(fmu_dir: str | Path = "fmus", params_file: str | Path | None = Non
     compiles each target's C library first (measured on 2 cores: linux64 17 s, aarch64-linux 22 s, darwin64 17 s,
     win64 148 s on a loaded machine), which alone would take the main job past its 3 minutes. ``rotorub build-fmu
     --native`` builds the five platforms (README, "The FMUs")."""
-    from .cli import build
     from .fmi.compile import host_platform
+    from .models.contact.builder import build_with_kit as build
     from .models.spool.builder import build_native_spool_fmu
     from .systems.coupling import scenario_settings
     from .systems.manoeuvre_scenario import build_manoeuvre_fmus

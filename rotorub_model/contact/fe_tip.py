@@ -3,7 +3,7 @@
 The tip nodes of a solid mesh spread over the chord and the thickness. Along the chord they are gathered into
 **stations** (nodes within a thousandth of the chord of one another: the two faces of the tip; or, beyond
 ``stations`` of them, equal bins of the chord), each the mean of its nodes: its rest position and its map from
-the dofs (the disk's rigid motion, the blade's reduced modes: ``fe.bladed_disk.tip_point_maps``). Consecutive
+the dofs (the disk's rigid motion, the blade's reduced modes: ``structure.tips.tip_node_maps``). Consecutive
 stations bound **segments**; each segment carries the paper's chord law (eq. 5-8) over its own length, with the
 gap linear between its two stations, the pressure k_r / L where it penetrates (L the tip's chord: a tip pressed
 evenly carries k_r times its penetration, as the built-in blades), and friction at its two ends. So the 3D law
@@ -27,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..structure.model import Model
+from ..structure.tips import tip_node_maps
 from .geometry import ContactGeometry, TipLayout
 
 SAME_STATION = 1e-3  # nodes closer than this fraction of the chord along it are one station
@@ -70,34 +71,6 @@ def stations(positions: np.ndarray, max_stations: int = DEFAULT_STATIONS) -> tup
         members[g] = k
     station_c = np.array([c[g].mean() for g in groups])
     return members, station_c, chord
-
-
-def tip_node_maps(p, blade) -> tuple[np.ndarray, np.ndarray]:
-    """(points (N, n_t, 3), Jb (N, n_t, 3, n)): every tip node's rest position in the rotating frame (origin at
-    the fan disk's centre, z axial from the disk's station) and the map from the bladed disk's dofs [shaft,
-    blades] to its displacement: t + theta x rho0 + Rz(alpha_j) (tip_recovery @ q_j). ``blade``: anything with
-    ``tip_positions`` (n_t, 3), ``tip_recovery`` (n_t, 3, m) and ``m`` (a ReducedBlade, or a saved model's
-    :class:`~rotorub_model.structure.model.ImportedTip`); numpy only (the pythonfmu FMU's host has no scipy)."""
-    from ..structure.shaft import station_maps
-
-    ns = 2 * p.shaft.n_ritz
-    m = blade.m
-    N = p.blades.count
-    n = ns + N * m
-    T, Rm = station_maps(p, p.fan_disk.z)
-    nt = blade.tip_positions.shape[0]
-    points = np.zeros((N, nt, 3))
-    Jb = np.zeros((N, nt, 3, n))
-    for j in range(N):
-        a = 2.0 * np.pi * j / N
-        c, s = np.cos(a), np.sin(a)
-        R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-        for i in range(nt):
-            rho0 = R @ blade.tip_positions[i]
-            points[j, i] = rho0
-            Jb[j, i, :, :ns] = T - np.cross(rho0[:, None], Rm, axis=0)
-            Jb[j, i, :, ns + j * m:ns + (j + 1) * m] = R @ blade.tip_recovery[i]
-    return points, Jb
 
 
 def geometry_fe(model: Model, theta: float, max_stations: int = DEFAULT_STATIONS) -> ContactGeometry:

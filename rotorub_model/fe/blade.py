@@ -38,6 +38,8 @@ from ..errors import FEImportError
 from .femodel import FEModel
 from .reduction import (
     TWO_PI,
+    complement,
+    condensed,
     factorize,
     lowest_modes,
     orthonormal_basis,
@@ -413,21 +415,6 @@ def tip_normalised_modes(fe: FEModel, V: np.ndarray, tip_rows: np.ndarray) -> np
     comp = tv[imax, :, np.arange(V.shape[1])]  # (m, 3)
     sign = np.sign(comp[np.arange(V.shape[1]), np.argmax(np.abs(comp), axis=1)])
     return V * (sign / scale)
-
-
-def complement(P: np.ndarray, V: np.ndarray, M) -> np.ndarray:
-    """An M-orthonormal basis of what the columns of P add to span(V) (V M-orthogonal columns)."""
-    MV = M @ V
-    C = P - V @ np.linalg.solve(V.T @ MV, MV.T @ P)
-    C = C / np.sqrt(np.einsum("ij,ij->j", C, M @ C))  # scale first: the added parts are small in mass
-    return orthonormal_basis([C], M, tol=1e-10)
-
-
-def condensed(V: np.ndarray, C: np.ndarray, K) -> np.ndarray:
-    """K on span(V) with the directions C condensed statically (massless): K_VV - K_VC K_CC^-1 K_CV."""
-    KV, KC = K @ V, K @ C
-    Kvc = V.T @ KC
-    return V.T @ KV - Kvc @ np.linalg.solve(C.T @ KC, Kvc.T)
 
 
 def tip_statics(fe: FEModel, frame: BladeFrame, V: np.ndarray, tip_rows: np.ndarray, f0) -> tuple:

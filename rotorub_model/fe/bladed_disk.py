@@ -30,6 +30,7 @@ import numpy as np
 from ..structure.frames import Matrices
 from ..structure.params import Parameters
 from ..structure.shaft import shaft_dof_names, station_maps
+from ..structure.tips import tip_node_maps
 from .blade import ReducedBlade
 from .rotating import P3, Z3
 
@@ -100,7 +101,5 @@ def tip_point_maps(p: Parameters, blade: ReducedBlade) -> tuple[np.ndarray, np.n
     """(points (N, n_t, 3), Jb (N, n_t, 3, n)): every tip node's rest position in the rotating frame (origin at
     the fan disk's centre, z axial from the disk's station) and the map from the bladed disk's dofs [shaft,
     blades] to its displacement: t + theta x rho0 + Rz(alpha_j) (tip_recovery @ q_j) (the contact's own,
-    :func:`rotorub_model.contact.fe_tip.tip_node_maps`)."""
-    from ..contact.fe_tip import tip_node_maps
-
+    :func:`rotorub_model.structure.tips.tip_node_maps`, which the contact reads)."""
     return tip_node_maps(p, blade)

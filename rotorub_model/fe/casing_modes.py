@@ -26,7 +26,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from ..errors import FEImportError
-from ..structure.frames import Matrices, axisymmetric_to_rotating, block_diag
+from ..structure.frames import Matrices
 from ..structure.params import Parameters
 
 
@@ -213,20 +213,13 @@ def casing_from_matrices(K: sp.spmatrix, M: sp.spmatrix, dof_nodes: np.ndarray, 
 def fe_casing_matrices(p: Parameters, casing: FECasing) -> Matrices:
     """The casing block with the FE modes (p.casing.modes nodal diameters) in place of the ring's: rigid
     translation and tilt as structure/casing.py, dofs casing.t.*, casing.r.*, casing.n{n}.*."""
-    c, s = p.casing, p.suspension
-    one, zero = np.ones((1, 1)), np.zeros((1, 1))
-    parts = [
-        axisymmetric_to_rotating(c.mass * one, s.c_translation * one, s.k_translation * one, zero, 1,
-                                 ["casing.t.x", "casing.t.y"]),
-        axisymmetric_to_rotating(c.tilt_inertia * one, s.c_rotation * one, s.k_rotation * one, zero, 1,
-                                 ["casing.r.x", "casing.r.y"]),
-    ]
-    for n in c.modes:
+    from ..structure.casing import casing_matrices
+
+    def modal(n: int) -> tuple[float, float, float]:
         md = casing.mode(n)
-        cn = 2.0 * md.damping_ratio * np.sqrt(md.modal_stiffness * md.modal_mass)
-        parts.append(axisymmetric_to_rotating(md.modal_mass * one, cn * one, md.modal_stiffness * one, zero, n,
-                                              [f"casing.n{n}.x", f"casing.n{n}.y"]))
-    return block_diag(parts)
+        return md.modal_mass, md.modal_stiffness, md.damping_ratio
+
+    return casing_matrices(p, modal)
 
 
 def fe_casing_point_map(p: Parameters, casing: FECasing, point: np.ndarray) -> np.ndarray:

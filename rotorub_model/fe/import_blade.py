@@ -18,9 +18,9 @@ import numpy as np
 from ..errors import FEImportError
 from ..plotting import pyplot, save_figure
 from ..writing import write_json
-from .blade import ReducedBlade, condensed, load_superelement, reduce_blade
+from .blade import ReducedBlade, load_superelement, reduce_blade
 from .femodel import FEModel
-from .reduction import TWO_PI, compare_reductions, contact_stiffness, explicit_step, mac
+from .reduction import TWO_PI, compare_reductions, condensed, contact_stiffness, explicit_step, mac
 
 CALCULIX_SUFFIXES = (".sti", ".mas", ".dof", ".inp", "")
 VARIANTS_MAX_DOFS = 20000  # above, the comparison of reductions costs more than the import: asked for only

@@ -194,8 +194,6 @@ def compare_reductions(K0, Ktop, M, cutoff_hz: float, tip_rows: np.ndarray, norm
     """Measure the variants on one blade (free dofs; ``tip_rows`` (n_t, 3) the tip nodes' x, y, z rows, all
     free; ``normals`` (n_t, 3) their contact normals in the file's axes). Returns the variants and the full
     model's reference frequencies."""
-    from .blade import complement, condensed
-
     f0 = factor0 or factorize(K0, "stiffness at rest")
     ft = factor_top or factorize(Ktop, "stiffness at the top speed")
     w0, P0 = rest or lowest_modes(K0, M, f0, cutoff_hz, at_least=n_compare)
@@ -268,3 +266,18 @@ def compare_reductions(K0, Ktop, M, cutoff_hz: float, tip_rows: np.ndarray, norm
     Vcb[flat, wi.size + np.arange(flat.size)] = 1.0
     out.append(measure("craig-bampton", Vcb, t))
     return out, ref
+
+
+def complement(P: np.ndarray, V: np.ndarray, M) -> np.ndarray:
+    """An M-orthonormal basis of what the columns of P add to span(V) (V M-orthogonal columns)."""
+    MV = M @ V
+    C = P - V @ np.linalg.solve(V.T @ MV, MV.T @ P)
+    C = C / np.sqrt(np.einsum("ij,ij->j", C, M @ C))  # scale first: the added parts are small in mass
+    return orthonormal_basis([C], M, tol=1e-10)
+
+
+def condensed(V: np.ndarray, C: np.ndarray, K) -> np.ndarray:
+    """K on span(V) with the directions C condensed statically (massless): K_VV - K_VC K_CC^-1 K_CV."""
+    KV, KC = K @ V, K @ C
+    Kvc = V.T @ KC
+    return V.T @ KV - Kvc @ np.linalg.solve(C.T @ KC, Kvc.T)

@@ -23,6 +23,8 @@ radial displacement in the rotating frame).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from .frames import Matrices, axisymmetric_to_rotating, block_diag
@@ -44,7 +46,10 @@ def ring_modal(p: Parameters, n: int) -> tuple[float, float]:
     return m, k
 
 
-def casing_matrices(p: Parameters) -> Matrices:
+def casing_matrices(p: Parameters, modal: Callable[[int], tuple[float, float, float]] | None = None) -> Matrices:
+    """The casing block: rigid translation and tilt on the suspension, then one mode pair per nodal diameter of
+    ``p.casing.modes``. ``modal``: n -> (modal mass, modal stiffness, damping ratio) in place of the thin ring's
+    (an FE casing's modes, fe/casing_modes.py); the dofs are the same."""
     c, s = p.casing, p.suspension
     one = np.ones((1, 1))
     zero = np.zeros((1, 1))
@@ -55,8 +60,8 @@ def casing_matrices(p: Parameters) -> Matrices:
                                  ["casing.r.x", "casing.r.y"]),
     ]
     for n in c.modes:
-        m, k = ring_modal(p, n)
-        cn = 2.0 * c.damping_ratio * np.sqrt(k * m)
+        m, k, zeta = modal(n) if modal is not None else (*ring_modal(p, n), c.damping_ratio)
+        cn = 2.0 * zeta * np.sqrt(k * m)
         parts.append(axisymmetric_to_rotating(m * one, cn * one, k * one, zero, n,
                                               [f"casing.n{n}.x", f"casing.n{n}.y"]))
     return block_diag(parts)

@@ -217,8 +217,8 @@ def test_crosscheck_kit_of_the_example(example, tmp_path):
 def test_fmi3_fmu_of_the_example_reproduces_its_kit(tmp_path):
     """`rotorub build-fmu --native --fmi3 --params example.toml`: the FMI 3.0 FMU (per-blade arrays) with the
     imported tip reproduces its own kit (FMI 3.0 columns) to the kit's bound."""
-    from fmu_src.cli import build
     from fmu_src.masters import crosscheck as runs
+    from fmu_src.models.contact.builder import build_with_kit as build
 
     out = build(tmp_path, EXAMPLE, native=True, fmi3=True, platforms=("linux64",))
     r3 = runs.run_fmi3(out["fmu"], tmp_path)

@@ -57,7 +57,7 @@ def _compiler_or_skip() -> None:
 def built3(tmp_path_factory):
     """`rotorub build-fmu --native --fmi3` (linux64): the FMU and its cross-check kit."""
     _compiler_or_skip()
-    from fmu_src.cli import build
+    from fmu_src.models.contact.builder import build_with_kit as build
 
     out = build(tmp_path_factory.mktemp("fmi3"), native=True, fmi3=True, platforms=("linux64",))
     return out

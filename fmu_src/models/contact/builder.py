@@ -333,3 +333,24 @@ def build_fmu(dest: str | Path = "fmus", params_file: str | Path | None = None,
             "variables": len(own), "blades": params.blades.count, "build": tag, "flavour": "pythonfmu",
             "mode": mode, "parameters": str(params_path), "host_requirements": HOST_REQUIREMENTS,
             "kernel_platforms": manifest["kernel_platforms"], "exit_double_release_patched": patched}
+
+
+def build_with_kit(dest: str | Path, params: str | Path | None = None, native: bool = False,
+                   mode: str = "transient", platforms: tuple[str, ...] | None = None, fmi3: bool = False) -> dict:
+    """Build one flavour of RotorCasingContact.fmu into ``dest`` and write its cross-check kit next to it
+    (``fmi3``: the native FMI 3.0 FMU and its kit): what ``rotorub build-fmu`` and the main job build."""
+    from rotorub_model.structure.params import load_parameters
+
+    from ...fmi.compile import NativeBuildError
+    from . import crosscheck
+
+    if fmi3 and not native:
+        raise NativeBuildError("--fmi3: the FMI 3.0 FMU is the native one: add --native (pythonfmu 0.7 writes FMI "
+                               "2.0 only)")
+    if native:
+        out = build_native_fmu(dest, params, platforms, mode, fmi="3.0" if fmi3 else "2.0")
+    else:
+        out = build_fmu(dest, params, platforms, mode)
+    kit = crosscheck.write_kit(Path(out["fmu"]).parent, load_parameters(params) if params else None,
+                               fmi="3.0" if fmi3 else "2.0")
+    return {**out, "crosscheck_kit": sorted(str(p) for p in kit.values())}

@@ -45,7 +45,8 @@ RE_TOL = 1e-6  # a real part below this is a neutral mode's round-off (rotorub_m
 # submodules of the bundled library imported eagerly: a later lazy import must not
 # depend on the folder it came from still existing (masters delete extracted FMUs)
 _LIB_MODULES = ("errors", "writing", "plotting", "kernel.compiler", "kernel", "structure.params", "structure.frames",
-                "structure.ritz", "structure.shaft", "structure.blades", "structure.casing", "structure.model",
+                "structure.ritz", "structure.shaft", "structure.tips", "structure.blades", "structure.casing",
+                "structure.model",
                 "contact.geometry", "contact.point2d", "contact.chord3d", "contact.fe_tip", "contact.contact_model",
                 "contact",
                 "contact.liner",
