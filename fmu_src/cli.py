@@ -18,6 +18,10 @@ def _add_build_args(sp: argparse.ArgumentParser) -> None:
                     help="default of the mode parameter, and the output dependencies the FMU declares")
     from .fmi.compile import ALL_PLATFORMS  # light: the builder itself is imported only to build
 
+    # no --out: the FMUs go where the harnesses and the README look for them (fmus/, fmus/native/, ...); a --out
+    # given, even the other commands' "out/build-fmu", is taken as it is
+    sp.set_defaults(out=None)
+
     sp.add_argument("--platforms", nargs="+", default=None,
                     help=f"platforms to build (native: {' '.join(ALL_PLATFORMS)}; pythonfmu kernel: linux64 win64, "
                          "the platforms pythonfmu 0.7 has a binary for); default: all of them when ziglang is "
@@ -33,7 +37,7 @@ def _run_build(ns: argparse.Namespace) -> dict:
     from .models.contact.builder import build_with_kit
 
     default = Path("fmus") / (("native-fmi3" if ns.fmi3 else "native") if ns.native else "")
-    dest = default if ns.out == "out/build-fmu" else Path(ns.out)
+    dest = default if ns.out is None else Path(ns.out)
     try:
         r = build_with_kit(dest, ns.params, ns.native, ns.mode, tuple(ns.platforms) if ns.platforms else None,
                            ns.fmi3)
