@@ -245,8 +245,11 @@ def cmd_static(ns: argparse.Namespace) -> Done:
     from ..writing import write_json
 
     write_json(Path(ns.out) / "summary.json", s)
+    from ..contact.laws import knee_note
+
+    note = knee_note(m.params.contact, float(-st.gaps.min(initial=0.0))) if st.converged else ""
     lines = [f"{ns.formulation} static solution at Ω = {ns.speed:.4g} Ω_ref, g0 = {ns.g0 * 1e3:.4g} mm: "
-             f"{st.verdict()}.", files_line(ns.out)]
+             f"{st.verdict()}." + (f" Note: {note}." if note else ""), files_line(ns.out)]
     return Done(s, lines)
 
 

@@ -23,6 +23,7 @@ from ..analyses.transient import (  # noqa: F401 - the growth verdict's names, u
     run_transient,
 )
 from ..contact import make_contact
+from ..contact.laws import knee_note
 from ..errors import ParameterError
 from ..plotting import pyplot, save_figure
 from ..progress import say, stage
@@ -287,6 +288,11 @@ def _qualifies(st: dict) -> bool:
                 and s3["static"].n_contact > 0 and not s2["stability"].stable and s3["stability"].stable)
 
 
+def _deepest(*runs: TransientResult) -> float:
+    """The deepest penetration [m] over runs (the largest -gap recorded; 0 where nothing touched)."""
+    return max((float(-np.min(r.outputs["gap"], initial=0.0)) for r in runs), default=0.0)
+
+
 @dataclass
 class TransientStudy:
     speed: float
@@ -294,6 +300,7 @@ class TransientStudy:
     runs: dict[str, TransientResult]
     statics: dict
     point: TransientPoint | None = None  # how the point was chosen (None: given)
+    contact: object | None = None  # the [contact] parameters (the law's note)
 
     def summary(self) -> dict:
         r2, r3 = self.runs["2D"], self.runs["3D"]
@@ -318,9 +325,11 @@ class TransientStudy:
             "envelope_growing": {"2D": r2.envelope_growing, "3D": r3.envelope_growing},
             "envelope_growth": {"2D": g2, "3D": g3},
             "verdicts": {"2D": r2.verdict(), "3D": r3.verdict()},
-            "verdict_note": "" if g2["factor"] is not None and g3["factor"] is not None else
-            "a run shorter than 4 s gets no growth verdict: diverged is null unless the penetration limit was hit "
-            "(the envelope's growth is fitted over the second half of a run of at least 4 s)",
+            "verdict_note": "; ".join(n for n in (
+                "" if g2["factor"] is not None and g3["factor"] is not None else
+                "a run shorter than 4 s gets no growth verdict: diverged is null unless the penetration limit was hit "
+                "(the envelope's growth is fitted over the second half of a run of at least 4 s)",
+                knee_note(self.contact, _deepest(r2, r3)) if self.contact is not None else "") if n),
             "point": self.point.summary() if self.point else {"source": "given"},
             "settled_3d": settled(r3, st3.q) if st3.converged else False,
             "blades_in_contact_2d_at_1s": r2.blades_in_contact(i2),
@@ -435,7 +444,7 @@ def run_transient_study(model: Model, out: str | Path, speed: float | None = Non
     statics = point_status(model, speed, g0)
     runs = {f: run_transient(model, make_contact(model, f, g0=g0), omega, t_end=t_end, progress=progress)
             for f in ("2D", "3D")}
-    return TransientStudy(speed, g0, runs, statics, point).save(out)
+    return TransientStudy(speed, g0, runs, statics, point, model.params.contact).save(out)
 
 
 def run_wear_study(model: Model, out: str | Path, speed: float | None = None, g0: float | None = None,

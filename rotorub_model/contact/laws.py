@@ -46,3 +46,23 @@ def max_slope(name: str, params: tuple[float, ...]) -> float:
     import ctypes
 
     return float(kernel.load().rr_law_max_slope(ctypes.byref(law_record(name, params))))
+
+
+def knee_note(contact: Any, deepest_penetration: float) -> str:
+    """A sentence when a law's change of slope was never reached, so the results are those of its first branch
+    (the penalty law's) and a reader should not take them for the law's effect; "" otherwise (or for a law without
+    a knee). ``contact``: the ``[contact]`` parameters; ``deepest_penetration`` [m]: the largest -gap of the run.
+
+    >>> from rotorub_model.structure.params import reference_parameters
+    >>> c = reference_parameters().replace(contact={"law": "bilinear", "knee": 3e-4}).contact
+    >>> for part in knee_note(c, 27e-6).split(": "):
+    ...     print(part)
+    the bilinear law's knee (0.3 mm) was never reached (deepest penetration 0.027 mm)
+    these are the penalty law's results
+    >>> knee_note(c, 4e-4)
+    ''
+    """
+    if "knee" not in LAWS[contact.law] or deepest_penetration >= contact.knee:
+        return ""
+    return (f"the {contact.law} law's knee ({contact.knee * 1e3:.3g} mm) was never reached (deepest penetration "
+            f"{max(deepest_penetration, 0.0) * 1e3:.3g} mm): these are the penalty law's results")

@@ -234,3 +234,19 @@ def test_parameter_file_selects_the_law(tmp_path):
         with pytest.raises(ParameterError, match=word):
             reference_parameters().replace(contact=bad)
     assert set(LAWS) == {"penalty", "bilinear"}
+
+
+@pytest.mark.parametrize("knee, noted", [(5e-3, True), (1e-6, False)])
+def test_the_static_verdict_says_when_the_knee_was_never_reached(write_params, tmp_path, capsys, knee, noted):
+    """A bilinear law whose knee the solution never reaches gives the penalty law's numbers: the verdict says so (a
+    reader would otherwise take them for the law's effect), and says nothing once the knee is passed."""
+    from rotorub_model.app.cli import main
+    from rotorub_model.structure.params import to_dict
+
+    p = reference_parameters().replace(contact={"law": "bilinear", "knee": knee, "stiffness_ratio": 4.0})
+    path = write_params(to_dict(p))
+    rc = main(["static", "--params", str(path), "--speed", "3.3", "--g0", "0.3mm", "--formulation", "2D",
+               "--out", str(tmp_path / "st")])
+    out = capsys.readouterr().out
+    assert rc == 0
+    assert ("the bilinear law's knee (5 mm) was never reached" in out) is noted, out
