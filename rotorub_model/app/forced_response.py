@@ -29,15 +29,6 @@ def forcing_from_args(g0: float, lobe: int | None, amplitude: float | None, phas
     return f
 
 
-def refuse_imported(model: Model) -> None:
-    """The harmonic balance does not take imported blades yet (its contact basis reads dense contact rows, its tip
-    measures the built-in blade's functions: analyses/harmonic/): one line rather than a traceback."""
-    if model.fe_blade is not None:
-        raise ParameterError("fe_blade.superelement: the harmonic balance (forced-response) does not take imported "
-                             "blades yet; accepted: the built-in blades (no [fe_blade]); the transients (rotorub "
-                             "transient, wear) take them")
-
-
 def run_forced_response(model: Model, out: str | Path, speeds: tuple[float, float], formulation: str = "2D",
                         g0: float | None = None, forcing: CasingForcing | None = None, harmonics: int = 10,
                         transients: int = 0, t_end: float = 60.0, wear: bool = True, executor=None,
@@ -46,7 +37,6 @@ def run_forced_response(model: Model, out: str | Path, speeds: tuple[float, floa
     ~0.99 to the classifier's 2e-3), at the step T/64 divided by ``refine`` (default 2 in 3D: at T/64 the fast
     blade mode's error alone is 3 % of the tip amplitude on the oval reference; docs/THEORY.md section 8)."""
     refine = (2 if formulation == "3D" else 1) if refine is None else int(refine)
-    refuse_imported(model)
     r = run_interaction_map(model, formulation, speeds, g0=g0, forcing=forcing, harmonics=harmonics,
                             n_transients=transients, t_end=t_end, wear=wear, executor=executor, progress=True,
                             refine=refine)
@@ -60,7 +50,6 @@ def run_forced_quick(model: Model, out: str | Path) -> tuple[InteractionMap, str
     """The main job's quick forced response: 2D, clearance 0.5 g0 of the file, an oval casing (2 lobes of 0.3 of that
     clearance), speeds 2.5-4.5, H = 10, five 60 s transients through the process pool. Returns the result and its
     report section (the HB-transient agreement with each speed's verdict)."""
-    refuse_imported(model)
     g0 = 0.5 * model.params.contact.g0
     lo, hi = 2.5, min(4.5, model.params.normalisation.speed_max)
     r = run_interaction_map(model, "2D", (lo, hi), g0=g0, forcing=CasingForcing.lobe(2, 0.3 * g0),

@@ -135,6 +135,22 @@ class ContactModel:
         t = self.geometry.tips
         return t.n_dofs if t is not None else self.G.shape[1]
 
+    def dense_rows(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(G, A, B, S) over all n dofs: the rows as they are, or an imported tip's compact rows (each segment's
+        over its own columns) scattered to their dofs (what a projection on the contact's span needs)."""
+        t = self.geometry.tips
+        if t is None:
+            return self.G, self.A, self.B, self.S
+        n, npt = self.n_dofs, self.n_points
+
+        def scatter(X: np.ndarray, per_segment: int) -> np.ndarray:
+            out = np.zeros((X.shape[0], n))
+            seg = np.arange(X.shape[0]) // per_segment
+            out[np.arange(X.shape[0])[:, None], t.cols[seg]] = X
+            return out
+
+        return scatter(self.G, npt), scatter(self.A, 1), scatter(self.B, 1), scatter(self.S, npt)
+
     @property
     def n_rows(self) -> int:
         """Rows of the liner's worn depth: the points of a blade, or an imported tip's chord stations."""

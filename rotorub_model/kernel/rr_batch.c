@@ -105,30 +105,23 @@ int rr_batch_reduced_work_size(int n, int nb, int np, int r)
 int rr_batch_reduced(const rr_contact *c, int m, const double *y, const double *yd, double omega, const double *phi,
                      int r, const double *P, double *F, double *J, double *Jv, double *work)
 {
-    int i, j, k, a, b, p, n = c->n, nb = c->nb, np = c->np, rows = nb * np, touching = 0;
+    int i, j, k, a, b, p, n = c->n, nb = c->nb, np = c->np, rows = nb * np, touching = 0, ld = rri_ld(c);
     rr_surface *s = c->surface;
     const double phi0 = s ? s->phi : 0.0;
     double *q = work, *qd = q + n, *gaps = qd + n, *law = gaps + rows, *fr = law + (size_t)nb * RR_LAW_WIDTH;
     double *PA = fr + rows, *PB = PA + (size_t)nb * r, *PS = PB + (size_t)nb * r;
-    /* the contact's rows in the reduced coordinates: P A_j^T, P B_j^T, P S_p^T (A, B, S lie in P's span) */
+    /* the contact's rows in the reduced coordinates: P A_j^T, P B_j^T, P S_p^T (A, B, S lie in P's span); a
+     * segment's rows over its own columns when they are compact (an imported tip) */
     for (j = 0; j < nb; ++j)
         for (a = 0; a < r; ++a) {
-            const double *pa = P + (size_t)a * n, *Aj = c->A + (size_t)j * n, *Bj = c->B + (size_t)j * n;
-            double sa = 0.0, sb = 0.0;
-            for (k = 0; k < n; ++k) {
-                sa += pa[k] * Aj[k];
-                sb += pa[k] * Bj[k];
-            }
-            PA[(size_t)j * r + a] = sa;
-            PB[(size_t)j * r + a] = sb;
+            const double *pa = P + (size_t)a * n;
+            const int *cols = rri_cols(c, j);
+            PA[(size_t)j * r + a] = rri_dot(ld, c->A + (size_t)j * ld, cols, pa);
+            PB[(size_t)j * r + a] = rri_dot(ld, c->B + (size_t)j * ld, cols, pa);
         }
     for (j = 0; j < rows; ++j)
-        for (a = 0; a < r; ++a) {
-            const double *pa = P + (size_t)a * n, *Sj = c->S + (size_t)j * n;
-            double ss = 0.0;
-            for (k = 0; k < n; ++k) ss += pa[k] * Sj[k];
-            PS[(size_t)j * r + a] = ss;
-        }
+        for (a = 0; a < r; ++a)
+            PS[(size_t)j * r + a] = rri_dot(ld, c->S + (size_t)j * ld, rri_cols(c, j / np), P + (size_t)a * n);
     for (i = 0; i < m; ++i) {
         const double *yi = y + (size_t)i * r, *ydi = yd ? yd + (size_t)i * r : NULL;
         double *Fi = F + (size_t)i * r, *Ji = J ? J + (size_t)i * r * r : NULL, *Jvi = Jv ? Jv + (size_t)i * r * r : NULL;
@@ -158,7 +151,7 @@ int rr_batch_reduced(const rr_contact *c, int m, const double *y, const double *
             double w[2], aF[2], aM[2], f0, f1, fw0, fw1;
             if (L[0] == 0.0 && L[1] == 0.0 && L[2] == 0.0 && L[3] == 0.0 && L[4] == 0.0 && L[5] == 0.0) continue;
             contact = 1;
-            rri_point_weights(np, c->chord, L[0], L[1], w, aF, aM);
+            rri_point_weights(np, rri_len(c, j), L[0], L[1], w, aF, aM);
             f0 = fr[(size_t)j * np];
             f1 = np == 2 ? fr[(size_t)j * np + 1] : 0.0;
             fw0 = f0 * w[0];

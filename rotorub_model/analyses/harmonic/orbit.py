@@ -25,12 +25,35 @@ FINE_SAMPLES = 1024  # samples per period for the reported extremes (a force pea
 
 
 def tip_deflection(model: Model, q: np.ndarray) -> np.ndarray:
-    """v_j of every blade (..., N) from states q (..., n)."""
+    """v_j of every blade (..., N) from states q (..., n). An imported blade: its tip nodes' mean elastic
+    displacement along the direction the tip moves most (the leading left singular vector of the mean tip
+    recovery, 3 x m, in the blade's frame): a signed scalar like the built-in blade's psi(l_b) . b_j."""
     p = model.params
+    qb = q[..., model.slices["blades"]].reshape(*q.shape[:-1], p.blades.count, model.blade_dofs)
+    if model.fe_blade is not None:
+        return qb @ _fe_tip_row(model)
     psi = blade_functions(p, p.blades.length)[0]
-    nb = p.blades.dofs
-    qb = q[..., model.slices["blades"]]
-    return (qb.reshape(*q.shape[:-1], p.blades.count, nb) * psi).sum(axis=-1)
+    return (qb * psi).sum(axis=-1)
+
+
+def _fe_tip_row(model: Model) -> np.ndarray:
+    """(m,) the imported blade's tip deflection along its principal direction per reduced dof."""
+    tip = np.asarray(model.fe_blade.tip_recovery).mean(axis=0)  # (3, m)
+    u = np.linalg.svd(tip, full_matrices=False)[0][:, 0]
+    u = u if u[np.argmax(np.abs(u))] > 0 else -u  # one sign for every call
+    return u @ tip
+
+
+def blade_normal_forces(problem: HBProblem, law: np.ndarray) -> np.ndarray:
+    """Each blade's normal force (m, N) from the kernel's law values (m, N_kernel, LAW_WIDTH): an imported tip's
+    segments summed per blade (as the kernel's outputs report them), else the law's own column."""
+    c = problem.contact
+    t = None if c is None else c.geometry.tips
+    if t is None:
+        return law[:, :, 0]
+    out = np.zeros((law.shape[0], t.n_blades))
+    np.add.at(out, (slice(None), np.asarray(t.blade_of)), law[:, :, 0])
+    return out
 
 
 def disk_displacement(model: Model, q: np.ndarray) -> np.ndarray:
@@ -78,7 +101,7 @@ def measures_at_phases(problem: HBProblem, Y: np.ndarray, omega: float, w: float
     q = problem.basis.evaluate(Q, tau)
     phi = tau * (omega / w) if problem.forced else None
     gaps, law = problem.nl.laws(q, phi)
-    return measures_from_states(problem.model, q, law[:, :, 0], gaps, problem.H)
+    return measures_from_states(problem.model, q, blade_normal_forces(problem, law), gaps, problem.H)
 
 
 class OrbitView:
@@ -98,7 +121,7 @@ class OrbitView:
     def _laws(self) -> tuple[np.ndarray, np.ndarray]:
         """Blade normal forces (m, N) and gaps (m, N, P) at the fine samples, each at its own frame angle."""
         gaps, law = self.problem.nl.laws(self.q, self.phi if self.problem.forced else None)
-        return law[:, :, 0], gaps
+        return blade_normal_forces(self.problem, law), gaps
 
     def measures(self) -> OrbitMeasures:
         m = measures_from_states(self.problem.model, self.q, self.F_N, self.gaps, self.problem.H)

@@ -74,7 +74,7 @@ def _lib():
 
 def contact_basis(contact: ContactModel, tol: float = 1e-12) -> np.ndarray:
     """P (r x n): orthonormal rows spanning [G; S; A; B], what the contact force depends on and acts along."""
-    W = np.vstack([contact.G, contact.S, contact.A, contact.B])
+    W = np.vstack(contact.dense_rows())  # an imported tip's compact rows over all dofs
     _, s, Vt = np.linalg.svd(W, full_matrices=False)
     r = int(np.sum(s > tol * s[0])) if s.size and s[0] > 0 else 0
     return np.ascontiguousarray(Vt[:r])
@@ -125,7 +125,7 @@ class KernelContact:
             kernel.RRContact.from_buffer_copy(contact.kernel)
         self._vref = ctypes.byref(self._view)
         lib = _lib()
-        self._work = np.empty(lib.rr_batch_reduced_work_size(contact.n_dofs, contact.n_blades, contact.n_points,
+        self._work = np.empty(lib.rr_batch_reduced_work_size(contact.n_dofs, contact.n_segments, contact.n_points,
                                                              self.P.shape[0]))
         self.g0 = float(contact.g0)
 
@@ -150,12 +150,13 @@ class KernelContact:
         return F, J, Jv, int(touching)
 
     def laws(self, q: np.ndarray, phi: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-        """Gaps (m, N, P) and per-blade law values (m, N, LAW_WIDTH) at full states q (m, n), one kernel call."""
+        """Gaps (m, N, P) and law values (m, N, LAW_WIDTH) of the kernel's blades at full states q (m, n), one
+        kernel call (an imported tip: N its segments, :func:`.orbit.blade_normal_forces` sums them per blade)."""
         c = self.contact
         m = q.shape[0]
         q = np.ascontiguousarray(q, dtype=float)
-        gaps = np.empty((m, c.n_blades, c.n_points))
-        law = np.empty((m, c.n_blades, kernel.LAW_WIDTH))
+        gaps = np.empty((m, c.n_segments, c.n_points))
+        law = np.empty((m, c.n_segments, kernel.LAW_WIDTH))
         phi = None if phi is None else np.ascontiguousarray(phi, dtype=float)
         _lib().rr_batch_laws(self._vref, m, kernel.ptr(q), None if phi is None else kernel.ptr(phi),
                              kernel.ptr(gaps), kernel.ptr(law))
