@@ -466,8 +466,12 @@ def run_interaction_map(model: Model, formulation: str = "2D", speed_range: tupl
         bar = tqdm(desc=f"HB continuation {formulation}", unit="orbit", total=None)
     t0 = time.perf_counter()
     with threadpool_limits(limits=1):  # small dense algebra: BLAS threads only fight on a shared machine
+        def shown(p) -> None:  # where the branch is: a resonance can take hundreds of orbits of a small range
+            bar.set_postfix_str(f"Ω/Ω_ref = {p.omega / wr:.4g} in [{lo:g}, {hi:g}]", refresh=False)
+            bar.update(1)
+
         branch, seg = follow_segments(problem, lo * wr, hi * wr, g0, tip_cap(model, problem, contact),
-                                      max_points, (lambda p: bar.update(1)) if bar is not None else None)
+                                      max_points, shown if bar is not None else None)
         t_hb = time.perf_counter() - t0
         hb = hb_measures(problem, branch, wr)
         hb["segment"] = seg
