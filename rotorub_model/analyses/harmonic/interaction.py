@@ -397,6 +397,9 @@ def tip_cap(model: Model, problem: HBProblem, contact) -> callable:
     return halt
 
 
+BLAS_THREADS_FROM = 1500  # unknowns of the balance from which the branch's dense algebra uses every core
+
+
 def follow_segments(problem: HBProblem, start: float, stop: float, g0: float, halt, max_points: int,
                     progress=None, restart_step: float | None = None) -> tuple[HBBranch, np.ndarray]:
     """Continuation in Omega from ``start`` to ``stop`` in segments: a segment ends at the range's end, at
@@ -465,7 +468,10 @@ def run_interaction_map(model: Model, formulation: str = "2D", speed_range: tupl
 
         bar = tqdm(desc=f"HB continuation {formulation}", unit="orbit", total=None)
     t0 = time.perf_counter()
-    with threadpool_limits(limits=1):  # small dense algebra: BLAS threads only fight on a shared machine
+    # small dense algebra: BLAS threads only fight on a shared machine; a large balance (an imported blade's contact
+    # spans most of its dofs: 3108 unknowns for the example in 3D) is one dense LU a Newton step, which they share
+    # (measured 1.6x on 2 cores), and the transients run only after the branch
+    with threadpool_limits(limits=1 if problem.N < BLAS_THREADS_FROM else None):
         def shown(p) -> None:  # where the branch is: a resonance can take hundreds of orbits of a small range
             bar.set_postfix_str(f"Ω/Ω_ref = {p.omega / wr:.4g} in [{lo:g}, {hi:g}]", refresh=False)
             bar.update(1)
