@@ -9,6 +9,7 @@ import warnings
 
 import numpy as np
 import pytest
+from hb_checks import balance_in_every_dof, fd_jacobian  # tests/library/hb_checks.py
 from threadpoolctl import threadpool_limits
 
 from rotorub_model.analyses.harmonic.basis import HarmonicBasis, samples_for
@@ -54,9 +55,7 @@ def test_jacobian_is_the_derivative_of_the_residual(ref_model, formulation):
     Y = Y + 1e-6 * np.random.default_rng(0).standard_normal(Y.size)
     ev = pb.evaluate(Y, om, om)
     assert ev.touching > 0
-    h = 1e-9
-    Jfd = np.column_stack([(pb.evaluate(Y + h * e, om, om, False).R - pb.evaluate(Y - h * e, om, om, False).R) / (2 * h)
-                           for e in np.eye(Y.size)])
+    Jfd = fd_jacobian(pb, Y, om, om, 1e-9)
     assert np.abs(Jfd - ev.J).max() <= 1e-7 * np.abs(ev.J).max()
 
 
@@ -71,9 +70,7 @@ def test_jacobian_with_friction_damping(ref_model):
     Y = pb.linear_start(om, w) + 1e-5 * np.random.default_rng(2).standard_normal(pb.N)
     ev = pb.evaluate(Y, om, w)
     assert np.any(ev.Jvp)
-    h = 1e-10
-    Jfd = np.column_stack([(pb.evaluate(Y + h * e, om, w, False).R - pb.evaluate(Y - h * e, om, w, False).R) / (2 * h)
-                           for e in np.eye(Y.size)])
+    Jfd = fd_jacobian(pb, Y, om, w, 1e-10)
     assert np.abs(Jfd - ev.J).max() <= 1e-6 * np.abs(ev.J).max()
 
 
@@ -109,25 +106,7 @@ def test_condensation_is_exact(ref_model):
     om = 3.3 * wr
     pb = HBProblem(m, make_contact(m, "3D", g0=G0), 6, forcing=OFFSET)
     res = newton(pb, pb.linear_start(om, om), om, om)
-    Q = pb.full(res.Y, om, om)
-    b = pb.basis
-    q, qd = b.E @ Q, om * (b.dE @ Q)
-    liner = pb.liner
-    F = np.empty_like(q)
-    for i in range(b.m):
-        liner.struct.phi = float(b.tau[i])
-        c = pb.contact
-        k = liner.attach(c.kernel)
-        from rotorub_model import kernel
-
-        qi, qdi, fi = np.ascontiguousarray(q[i]), np.ascontiguousarray(qd[i]), np.empty(m.n_dofs)
-        c.lib.rr_force(k, kernel.ptr(qi), kernel.ptr(qdi), om, kernel.ptr(fi))
-        F[i] = fi
-    Fh = b.P @ F
-    D = b.derivative()
-    lhs = (om * om) * (D @ D @ Q) @ m.M.T + om * (D @ Q) @ (m.D + m.G(om)).T + Q @ m.K_omega(om).T
-    rhs = Fh.copy()
-    rhs[0] += m.force(om)
+    lhs, rhs, _ = balance_in_every_dof(pb, res.Y, om)
     assert np.abs(lhs - rhs).max() <= 1e-8 * np.abs(rhs).max()
 
 
