@@ -1,4 +1,6 @@
 /* rotorub kernel: explicit central differences (see rotorub_kernel.h; internal declarations in rr_internal.h). */
+#include <string.h>
+
 #include "rr_internal.h"
 
 /* ------------------------------------------------------------------ central differences */
@@ -159,52 +161,39 @@ static void cache_key(const rr_cd_state *s, const rr_contact *c, double omega, d
     }
 }
 
-/* the evaluation kept by the last call, if it was made at this state with these inputs: into gaps, law, fr */
-static int cache_take(rr_cd_job *job, const rr_contact *c, double omega, double dt, double *gaps, double *law,
-                      double *fr)
+/* The evaluation (gaps, laws, friction factors) lives in the job's cache when it has one, so nothing is copied
+ * between calls: the cache holds the key and the state it was made at, checked here, and the evaluation itself,
+ * which rr_cd_run writes in place. Without a cache (or on a surface that wears) it lives in the contact's scratch. */
+static double *cache_evaluation(const rr_cd_job *job, const rr_contact *c)
 {
-    const rr_cd_state *s = job->state;
-    int i, n = c->n, rows = c->nb * c->np, nl = c->nb * RR_LAW_WIDTH;
-    double key[RR_CACHE_KEY];
-    const double *kc = job->cache, *qc, *qpc, *g, *L, *f;
-    if (!kc || !job->cache_valid || (c->surface && c->surface->wears)) return 0;
-    qc = kc + RR_CACHE_KEY;
-    qpc = qc + n;
-    g = qpc + n;
-    L = g + rows;
-    f = L + nl;
-    cache_key(s, c, omega, dt, key);
-    for (i = 0; i < RR_CACHE_KEY; ++i)
-        if (!(key[i] == kc[i])) return 0;
-    for (i = 0; i < n; ++i)
-        if (!(s->q[i] == qc[i]) || !(s->q_prev[i] == qpc[i])) return 0;
-    for (i = 0; i < rows; ++i) gaps[i] = g[i];
-    for (i = 0; i < nl; ++i) law[i] = L[i];
-    for (i = 0; i < rows; ++i) fr[i] = f[i];
-    return 1;
+    return job->cache + RR_CACHE_KEY + 2 * c->n;
 }
 
-static void cache_keep(rr_cd_job *job, const rr_contact *c, double omega, double dt, const double *gaps,
-                       const double *law, const double *fr)
+/* whether the evaluation in the cache was made by the last call at this state with these inputs. Compared bit for
+ * bit: equal bits are equal values, and a value equal in another representation (-0 for 0) only costs an evaluation */
+static int cache_holds(const rr_cd_job *job, const rr_contact *c, double omega, double dt)
 {
     const rr_cd_state *s = job->state;
-    int i, n = c->n, rows = c->nb * c->np, nl = c->nb * RR_LAW_WIDTH;
-    double *kc = job->cache, *qc, *qpc, *g, *L, *f;
+    size_t n = (size_t)c->n;
+    double key[RR_CACHE_KEY];
+    const double *kc = job->cache, *qc = kc + RR_CACHE_KEY, *qpc = qc + n;
+    if (!job->cache_valid) return 0;
+    cache_key(s, c, omega, dt, key);
+    return memcmp(key, kc, sizeof key) == 0 && memcmp(s->q, qc, n * sizeof *qc) == 0 &&
+           memcmp(s->q_prev, qpc, n * sizeof *qpc) == 0;
+}
+
+/* the key and the state of the evaluation rr_cd_run left in the cache (none after a divergence) */
+static void cache_keep(rr_cd_job *job, const rr_contact *c, double omega, double dt)
+{
+    const rr_cd_state *s = job->state;
+    size_t n = (size_t)c->n;
+    double *kc = job->cache, *qc = kc + RR_CACHE_KEY, *qpc = qc + n;
     job->cache_valid = 0;
-    if (!kc || (c->surface && c->surface->wears) || s->diverged) return;
-    qc = kc + RR_CACHE_KEY;
-    qpc = qc + n;
-    g = qpc + n;
-    L = g + rows;
-    f = L + nl;
+    if (s->diverged) return;
     cache_key(s, c, omega, dt, kc);
-    for (i = 0; i < n; ++i) {
-        qc[i] = s->q[i];
-        qpc[i] = s->q_prev[i];
-    }
-    for (i = 0; i < rows; ++i) g[i] = gaps[i];
-    for (i = 0; i < nl; ++i) L[i] = law[i];
-    for (i = 0; i < rows; ++i) f[i] = fr[i];
+    memcpy(qc, s->q, n * sizeof *qc);
+    memcpy(qpc, s->q_prev, n * sizeof *qpc);
     job->cache_valid = 1;
 }
 
@@ -217,7 +206,7 @@ int rr_cd_run(rr_cd_job *job)
     const rr_cd_matrices *m = job->mats;
     int i, k, n = c->n, nb = c->nb, rows = nb * c->np;
     int done = 0, written = job->n_rec, rec_every = job->rec_every < 1 ? 1 : job->rec_every;
-    double *gaps = c->work, *law = gaps + rows, *fr = law + nb * RR_LAW_WIDTH, *rhs = fr + rows;
+    double *gaps, *law, *fr, *rhs = c->work + 2 * rows + nb * RR_LAW_WIDTH;
     double *q = s->q, *qp = s->q_prev;
     const double t0 = s->t, dt = s->dt, floor_gap = -s->max_pen, t_ramp = job->t_ramp, me = job->me;
     const double omega = job->omega;
@@ -227,9 +216,14 @@ int rr_cd_run(rr_cd_job *job)
     const int stop_on_contact = job->stop_on_contact, rec_cap = job->rec_cap;
     const int rec_wear_every = job->rec_wear_every < 1 ? 1 : job->rec_wear_every;
     double *const rec_wear = sf ? job->rec_wear : NULL, *const rec_q = job->rec_q, *const rec_out = job->rec_out;
+    /* a surface that wears changes between calls without a key to say so: its evaluation is never kept */
+    const int cached = job->cache != NULL && !(sf && sf->wears);
     int open = 1;
     job->done = 0;
     if (s->diverged) return 0;
+    gaps = cached ? cache_evaluation(job, c) : c->work;
+    law = gaps + rows;
+    fr = law + nb * RR_LAW_WIDTH;
     if (sf) sf->phi = s->phi; /* the surface is read, and cut, at the state's angle */
     if (sf && sf->wears && rri_surface_inputs_changed(sf)) {
         /* the engine's inputs changed since the last cut (or none yet): the return map sees the new surface
@@ -238,13 +232,14 @@ int rr_cd_run(rr_cd_job *job)
         rri_surface_recut(c, q, gaps);
         job->cache_valid = 0;
     }
-    if (!cache_take(job, c, omega, dt, gaps, law, fr)) {
+    if (!(cached && cache_holds(job, c, omega, dt))) {
         rri_gaps_of(c, q, gaps);
         rri_laws_of(c, gaps, law);
         rri_friction_of(c, law, omega, NULL, q, qp, dt, fr);
     }
-    for (k = 0; k < rows; ++k)
-        if (gaps[k] < 0.0) open = 0;
+    if (stop_on_contact)
+        for (k = 0; k < rows; ++k)
+            if (gaps[k] < 0.0) open = 0;
     for (i = 0; i < job->n_steps; ++i) {
         double t = t0 + i * dt;
         double r = (t_ramp <= 0.0 || t >= t_ramp) ? 1.0 : t / t_ramp;
@@ -280,7 +275,7 @@ int rr_cd_run(rr_cd_job *job)
             }
             ++job->n_rec_wear;
         }
-        if ((step0 + i + 1) % rec_every == 0 && written < rec_cap) {
+        if (written < rec_cap && (step0 + i + 1) % rec_every == 0) {
             for (k = 0; k < n; ++k) rec_q[(size_t)written * n + k] = q[k];
             if (rec_out)
                 rri_outputs_from_law(c, q, gaps, law, fr, 0.0, NULL,
@@ -305,7 +300,10 @@ int rr_cd_run(rr_cd_job *job)
     job->n_rec = written;
     job->done = done;
     if (job->out_dest) rri_outputs_from_law(c, q, gaps, law, fr, s->phi, job->out_index, job->out_dest);
-    cache_keep(job, c, omega, dt, gaps, law, fr);
+    if (cached)
+        cache_keep(job, c, omega, dt);
+    else
+        job->cache_valid = 0;
     return done;
 }
 

@@ -219,70 +219,95 @@ void rr_jacobian(const rr_contact *c, const double *q, const double *qdot, doubl
 
 /* ------------------------------------------------------------------ outputs of a state */
 
+/* one kernel blade's (or tip segment's) force on the casing, added to Fc and its torque about e_z; returns its
+ * friction force along the tangents */
+static double segment_on_casing(const rr_contact *c, int j, const double *L, const double *fr, double *Fc,
+                                double *torque)
+{
+    int k, p, np = c->np;
+    double w[2], aF[2], aM[2], ft = 0.0;
+    if (L[0] == 0.0 && L[1] == 0.0) return 0.0;
+    rri_point_weights(np, rri_len(c, j), L[0], L[1], w, aF, aM);
+    for (p = 0; p < np; ++p) {
+        /* on the casing: w_p (n_p + f_p t_p); its torque on the rotor about e_z is the opposite */
+        size_t pk = (size_t)j * np + p;
+        const double *P = c->points + 3 * pk, *nv = c->normals + 3 * pk, *tv = c->tangents + 3 * pk;
+        double f[3];
+        for (k = 0; k < 3; ++k) {
+            f[k] = w[p] * (nv[k] + fr[pk] * tv[k]);
+            Fc[k] += f[k];
+        }
+        *torque -= P[0] * f[1] - P[1] * f[0];
+        ft += fr[pk] * w[p];
+    }
+    return ft;
+}
+
+/* the lesser tip gap, a NaN propagating as numpy's min does */
+static double gap_min(double a, double b) { return (a <= b || a != a) ? a : b; }
+
 void rri_outputs_from_law(const rr_contact *c, const double *q, const double *gaps, const double *law,
                           const double *fr, double phi, const int *index, double *dest)
 {
-    int j, k, p, nb = c->nb, np = c->np, n = c->n, nbo = rri_nb_out(c);
+    int j, k, nb = c->nb, np = c->np, n = c->n, nbo = rri_nb_out(c);
     double Fc[3] = {0.0, 0.0, 0.0}, torque = 0.0;
     double dx = 0.0, dy = 0.0, gmin = HUGE_VAL, cs, sn, vals[RR_OUT_GLOBALS];
-    /* what a reported blade gathers from its segments (a built-in blade: its one 'segment') */
-    double FN = 0.0, FT = 0.0, gle = 0.0, gte = 0.0, gtip = HUGE_VAL, frac = 0.0, len = 0.0;
-    int n_contact = 0, first = 1;
+    int n_contact = 0;
 #define RR_PUT(pos, value) (index ? (dest[index[(pos)]] = (value)) : (dest[(pos)] = (value)))
-    for (j = 0; j < nb; ++j) {
-        const double *L = law + RR_LAW_WIDTH * j;
-        int b = c->blade_of ? c->blade_of[j] : j, last = j + 1 == nb || (c->blade_of ? c->blade_of[j + 1] : j + 1) != b;
-        double w[2], aF[2], aM[2], lj = rri_len(c, j);
-        double sle = gaps[np * j], ste = gaps[np * j + np - 1];
-        double sg = (sle <= ste || sle != sle) ? sle : ste; /* a NaN propagates, as numpy's min */
-        double ft = 0.0;
-        if (!(L[0] == 0.0 && L[1] == 0.0)) {
-            rri_point_weights(np, lj, L[0], L[1], w, aF, aM);
-            for (p = 0; p < np; ++p) {
-                /* on the casing: w_p (n_p + f_p t_p); its torque on the rotor about e_z is the opposite */
-                size_t pk = (size_t)j * np + p;
-                const double *P = c->points + 3 * pk, *nv = c->normals + 3 * pk, *tv = c->tangents + 3 * pk;
-                double f[3];
-                for (k = 0; k < 3; ++k) {
-                    f[k] = w[p] * (nv[k] + fr[pk] * tv[k]);
-                    Fc[k] += f[k];
-                }
-                torque -= P[0] * f[1] - P[1] * f[0];
-                ft += fr[pk] * w[p];
+    if (!c->blade_of) { /* built-in blades: each kernel blade is a reported blade (the outputs' every step) */
+        for (j = 0; j < nb; ++j) {
+            const double *L = law + RR_LAW_WIDTH * j;
+            double gle = gaps[np * j], gte = gaps[np * j + np - 1], gtip = gap_min(gle, gte);
+            double FT = segment_on_casing(c, j, L, fr, Fc, &torque);
+            RR_PUT(RR_OUT_FN * nbo + j, L[0]);
+            RR_PUT(RR_OUT_FT * nbo + j, FT);
+            RR_PUT(RR_OUT_GAP_LE * nbo + j, gle);
+            RR_PUT(RR_OUT_GAP_TE * nbo + j, gte);
+            RR_PUT(RR_OUT_GAP_TIP * nbo + j, gtip);
+            RR_PUT(RR_OUT_FRACTION * nbo + j, L[6]);
+            if (L[0] > 0.0) ++n_contact;
+            if (gtip < gmin || gtip != gtip) gmin = gtip;
+        }
+    } else { /* an imported tip: a reported blade gathers its segments, leading edge first */
+        double FN = 0.0, FT = 0.0, gle = 0.0, gte = 0.0, gtip = HUGE_VAL, frac = 0.0, len = 0.0;
+        int first = 1;
+        for (j = 0; j < nb; ++j) {
+            const double *L = law + RR_LAW_WIDTH * j;
+            int b = c->blade_of[j], last = j + 1 == nb || c->blade_of[j + 1] != b;
+            double lj = rri_len(c, j), sle = gaps[np * j], ste = gaps[np * j + np - 1], sg = gap_min(sle, ste);
+            double ft = segment_on_casing(c, j, L, fr, Fc, &torque);
+            if (first) {
+                FN = L[0];
+                FT = ft;
+                gle = sle;
+                gtip = sg;
+                frac = L[6] * lj;
+                len = lj;
+            } else {
+                FN += L[0];
+                FT += ft;
+                if (sg < gtip || sg != sg) gtip = sg;
+                frac += L[6] * lj;
+                len += lj;
             }
+            gte = ste;
+            first = last;
+            if (!last) continue;
+            RR_PUT(RR_OUT_FN * nbo + b, FN);
+            RR_PUT(RR_OUT_FT * nbo + b, FT);
+            RR_PUT(RR_OUT_GAP_LE * nbo + b, gle);
+            RR_PUT(RR_OUT_GAP_TE * nbo + b, gte);
+            RR_PUT(RR_OUT_GAP_TIP * nbo + b, gtip);
+            RR_PUT(RR_OUT_FRACTION * nbo + b, frac / len);
+            if (FN > 0.0) ++n_contact;
+            if (gtip < gmin || gtip != gtip) gmin = gtip;
         }
-        if (first) { /* a blade's first segment: its leading edge */
-            FN = L[0];
-            FT = ft;
-            gle = sle;
-            gtip = sg;
-            frac = L[6] * lj;
-            len = lj;
-        } else {
-            FN += L[0];
-            FT += ft;
-            if (sg < gtip || sg != sg) gtip = sg;
-            frac += L[6] * lj;
-            len += lj;
-        }
-        gte = ste;
-        first = last;
-        if (!last) continue;
-        RR_PUT(RR_OUT_FN * nbo + b, FN);
-        RR_PUT(RR_OUT_FT * nbo + b, FT);
-        RR_PUT(RR_OUT_GAP_LE * nbo + b, gle);
-        RR_PUT(RR_OUT_GAP_TE * nbo + b, gte);
-        RR_PUT(RR_OUT_GAP_TIP * nbo + b, gtip);
-        RR_PUT(RR_OUT_FRACTION * nbo + b, c->blade_of ? frac / len : L[6]);
-        if (FN > 0.0) ++n_contact;
-        if (gtip < gmin || gtip != gtip) gmin = gtip;
     }
     for (k = 0; k < n; ++k) {
         dx += c->T2[k] * q[k];
         dy += c->T2[n + k] * q[k];
     }
-    cs = rr_cos(phi);
-    sn = rr_sin(phi);
+    rr_sincos(phi, &sn, &cs); /* one reduction of the angle for both (the same bits as rr_sin, rr_cos) */
     vals[RR_OUT_CASING_X] = cs * Fc[0] - sn * Fc[1];
     vals[RR_OUT_CASING_Y] = sn * Fc[0] + cs * Fc[1];
     vals[RR_OUT_CASING_Z] = Fc[2];

@@ -111,3 +111,72 @@ def test_eigenvalues_converge_where_the_classic_hqr_stopped(ref_model):
     lam = kernel.eigenvalues(P)
     ref = np.linalg.eigvals(P)
     np.testing.assert_allclose(np.sort(np.abs(lam)), np.sort(np.abs(ref)), rtol=1e-12, atol=1e-9 * np.abs(ref).max())
+
+
+def _advance_in_calls(model, contact, calls, between=None):
+    """Central differences from rest, in calls of the given step counts; `between(cd, k)` after call k. Returns the
+    final q and the records' outputs (rotating frame, one per step)."""
+    from rotorub_model.analyses.transient import CentralDifference
+
+    w = 3.3 * model.params.normalisation.omega_ref
+    cd = CentralDifference(model, contact, dt=2e-4, t_ramp=0.0)
+    cd.q[:] = 1e-4 * np.sin(np.arange(model.n_dofs))  # a state with blades in contact from the first step
+    cd.q_prev[:] = cd.q
+    rec_q, rec_out = np.zeros((sum(calls), model.n_dofs)), np.zeros((sum(calls), contact.n_outputs))
+    written = 0
+    for k, n in enumerate(calls):
+        _, written = cd.advance(n, w, model.params.imbalance.me, rec_every=1, rec_q=rec_q, rec_start=written,
+                                rec_out=rec_out)
+        if between is not None:
+            between(cd, k)
+    return cd.q.copy(), rec_out
+
+
+@pytest.mark.parametrize("formulation", ["2D", "3D"])
+def test_a_run_cut_into_calls_is_the_run_in_one_call(ref_model, formulation):
+    """The kernel keeps the contact evaluation of a call's last state for the next call (a communication step costs
+    its substeps, not one evaluation more): cut into calls, a run is the same run, bit for bit."""
+    c = make_contact(ref_model, formulation, g0=0.05e-3)
+    q1, out1 = _advance_in_calls(ref_model, c, [60])
+    q3, out3 = _advance_in_calls(ref_model, c, [1, 20, 39])
+    assert np.abs(out1[:, :10 * (c.n_points + 4)]).max() > 0  # blades touch: the kept evaluation carries forces
+    assert np.array_equal(q1, q3) and np.array_equal(out1, out3)
+
+
+def test_a_state_changed_between_calls_is_evaluated_afresh(ref_model):
+    """Between two calls the state may be written (a master restoring a state, a restart at the same velocity): the
+    kept evaluation must then not serve. The changed run equals a run that starts from the changed state; and the
+    same run with the kernel deceived into taking the kept evaluation (its record of the state overwritten with the
+    changed one) differs: the check is what keeps the two apart."""
+    c = make_contact(ref_model, "3D", g0=0.05e-3)
+    n = ref_model.n_dofs
+    evaluation = 2 * c.n_segments * c.n_points + 8 * c.n_segments  # gaps, friction factors; laws (RR_LAW_WIDTH)
+
+    def nudge(cd, k):
+        if k == 0:
+            cd.q[7] += 2e-5  # a dof of the first blade, in contact
+            cd.q_prev[7] += 2e-5
+
+    def nudge_deceived(cd, k):
+        nudge(cd, k)
+        if k == 0:  # the cache: key, q, q_prev, evaluation
+            at = len(cd._cache) - evaluation - 2 * n
+            cd._cache[at:at + n], cd._cache[at + n:at + 2 * n] = cd.q, cd.q_prev
+
+    q_a, out_a = _advance_in_calls(ref_model, c, [10, 30], between=nudge)
+    q_d, _ = _advance_in_calls(ref_model, c, [10, 30], between=nudge_deceived)
+    assert not np.array_equal(q_a, q_d)
+    # the changed run, from its changed state in one call
+    from rotorub_model.analyses.transient import CentralDifference
+
+    w = 3.3 * ref_model.params.normalisation.omega_ref
+    first = CentralDifference(ref_model, c, dt=2e-4, t_ramp=0.0)
+    first.q[:] = 1e-4 * np.sin(np.arange(n))
+    first.q_prev[:] = first.q
+    first.advance(10, w, ref_model.params.imbalance.me)
+    fresh = CentralDifference(ref_model, c, dt=2e-4, t_ramp=0.0)
+    fresh.q[:], fresh.q_prev[:] = first.q, first.q_prev
+    fresh.t, fresh.phi, fresh.steps = first.t, first.phi, first.steps
+    nudge(fresh, 0)
+    fresh.advance(30, w, ref_model.params.imbalance.me)
+    assert np.array_equal(q_a, fresh.q)
