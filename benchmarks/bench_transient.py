@@ -26,7 +26,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from timing import best_of_interleaved
+from timing import best_of_interleaved, pin_to_one_cpu
 
 from rotorub_model import kernel
 from rotorub_model.analyses.transient import CentralDifference, run_transient
@@ -57,6 +57,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeat", type=int, default=25)
     ns = ap.parse_args(argv)
 
+    pinned = pin_to_one_cpu()
     m = build_model()
     omega = 3.3 * m.params.normalisation.omega_ref
     me = m.params.imbalance.me
@@ -92,7 +93,7 @@ def main(argv: list[str] | None = None) -> int:
         t_lib, t_sparse, t_hold, t_bare = t["lib"], t["sparse"], t["hold"], t["bare"]
     h = library_hold()
     print(f"model: {m.n_dofs} dofs, 3D contact ({c.n_blades} blades x {c.n_points} points); "
-          f"{n_steps} steps of {r.dt:.3e} s ({ns.t_end:g} s), records every 1 ms: {len(r.t)}")
+          f"{n_steps} steps of {r.dt:.3e} s ({ns.t_end:g} s), records every 1 ms: {len(r.t)}; {pinned}")
     print(f"blades in contact at the end: {r.blades_in_contact()}; held-input run: {len(h.t)} records")
     print(f"run_transient end to end       : {t_lib / n_steps * 1e9:8.1f} ns/step  ({t_lib * 1e3:.1f} ms)")
     print(f"run_transient(hold=1 ms)       : {t_hold / n_steps * 1e9:8.1f} ns/step  ({t_hold * 1e3:.1f} ms)")

@@ -98,3 +98,19 @@ def test_the_study_figure_states_each_runs_verdict(study, ref_model):
     titles = [a.get_title() for a in fig.axes]
     assert any(t.startswith("2D: ") and ("diverged" in t or "not diverging" in t) for t in titles), titles
     assert np.all([("1/s" in t) for t in titles if t])
+
+
+@pytest.mark.parametrize("n_rec", [0, 3, 2500])
+def test_record_arrays_are_zeros_the_kernel_can_write(n_rec):
+    """The records' block (mapped with its pages present from POPULATE_FROM_BYTES on): zeros, C-contiguous and
+    writable, the two arrays side by side without overlap."""
+    from rotorub_model.analyses.transient import POPULATE_FROM_BYTES, record_arrays
+
+    q, out = record_arrays(n_rec, 38, 68)
+    assert q.shape == (n_rec, 38) and out.shape == (n_rec, 68)
+    for a in (q, out):
+        assert a.flags.c_contiguous and a.flags.writeable and not a.any()
+    q[...] = 1.0
+    assert not out.any()
+    if n_rec * 106 * 8 >= POPULATE_FROM_BYTES:
+        assert q.base is not None and out.base is q.base  # one block
