@@ -63,6 +63,20 @@ def all_closed_stiffness(contact: ContactModel, omega: float) -> np.ndarray:
     return contact.closed_stiffness(omega)
 
 
+def held_substep(model: Model, contact: ContactModel, omega: float, hold: float) -> float:
+    """The step the FMU takes through a communication step ``hold`` at spin speed ``omega``: hold / n, n = ceil(hold /
+    cap) equal substeps, cap half the stability limit at the speed rounded up to a whole rad/s (the FMU evaluates the
+    limit once per rad/s band; fmu_src/models/contact/model.c, substeps()) and at most the FMU's dt_max at its
+    default, 1 ms. ``run_transient(hold=...)`` follows it interval by interval, so that the library and the FMU run
+    the same steps on every configuration (a blade count whose limit crosses a multiple of hold/2 within a run-up
+    changes the plan there: 14 blades, 2 -> 3 substeps)."""
+    cap = min(FMU_DT_MAX, 0.5 * critical_time_step(model, contact, float(math.ceil(omega))))
+    return hold / max(1, math.ceil(hold / cap * (1.0 - 1e-9)))
+
+
+FMU_DT_MAX = 1e-3  # [s] the FMU's dt_max parameter at its default (fmu_src/models/contact/variables.py)
+
+
 def critical_time_step(model: Model, contact: ContactModel, omega: float) -> float:
     """2 / w_max of the linearised system with all contacts closed at the law's largest slope [s]: the kernel's
     (rr_critical_step), which both FMUs call too, so all pick the same step."""
@@ -608,9 +622,11 @@ def run_transient(
 
     ``hold`` [s] reproduces what a co-simulation master does with the FMU: the inputs
     (spin speed and ramped imbalance) are sampled at the start of each interval of
-    length ``hold`` and held over it (zero-order hold, Euler terms off), and the step
-    is the largest that divides ``hold`` within the stability cap. ``record_dt`` must
-    then be a whole multiple of ``hold``.
+    length ``hold`` and held over it (zero-order hold, Euler terms off), and each interval
+    is stepped as the FMU steps it (:func:`held_substep`: hold / n within half the stability
+    limit at the held speed, restarted at the same velocity where n changes; with ``dt``
+    given, or a liner, n = ceil(hold / dt) throughout). ``record_dt`` must then be a whole
+    multiple of ``hold``; records fall at the ends of the intervals.
 
     ``liner`` (contact/liner.py): the casing's abradable liner, cut as the run goes (its state is the
     liner's: a second run goes on from the profile the first left); its profile is recorded every
@@ -642,8 +658,15 @@ def run_transient(
         raise ParameterError(f"wear_record_dt: {wear_record_dt} out of range; accepted range (0, inf) s")
     integ = CentralDifference(model, contact, dt, 0.0 if hold else t_ramp, max_penetration,
                               omega_max_for_dt=float(speeds.max()), liner=liner)
-    if hold is not None:
-        # same rule as the FMU: n = ceil(h / cap) substeps per held interval
+    plan = None
+    if hold is not None and dt is None and liner is None:
+        # the FMU's plan, interval by interval (what a master sees of the FMU, step for step; see held_substep)
+        def plan(w: float) -> float:
+            return held_substep(model, contact, w, hold)
+
+        integ.dt = plan(omega_fn(0.0 if start is None else start.t))
+    elif hold is not None:
+        # a step given (or a liner: its profile records count steps): n = ceil(h / dt) substeps throughout
         integ.dt = hold / max(1, math.ceil(hold / integ.dt * (1 - 1e-9)))
     elif dt is None and record_dt > integ.dt:
         # automatic step: shrink it so the records fall exactly on multiples of record_dt
@@ -692,7 +715,36 @@ def run_transient(
         from tqdm import tqdm
 
         bar = tqdm(total=n_total, desc=f"{contact.formulation} transient", unit="step", unit_scale=True)
-    while done_total < n_total:
+    steps_used = {integ.dt}
+    if hold is not None:  # one held interval at a time, recorded at its end, as a master reads the FMU
+        n_held, rec_held = int(round(t_end / hold)), max(1, int(round(record_dt / hold)))
+        if bar is not None:
+            bar.total = n_total  # in the first interval's steps: the plan may change them
+        for k in range(n_held):
+            t_a = integ.t
+            w_k = omega_fn(t_a)
+            me_k = me * (1.0 if (t_ramp <= 0 or t_a >= t_ramp) else t_a / t_ramp)
+            if plan is not None and plan(w_k) != integ.dt:
+                integ.restart(plan(w_k), w_k)  # at the same velocity, as the FMU
+                steps_used.add(integ.dt)
+            n = max(1, int(round(hold / integ.dt)))
+            if (k + 1) % rec_held == 0 and written < n_rec:
+                done = integ.advance(n - 1, w_k, me_k)[0] if n > 1 else 0
+                if not integ.diverged and done == n - 1:
+                    before = written
+                    last, written = integ.advance(1, w_k, me_k, rec_every=1, rec_q=rec_q, rec_start=written,
+                                                  rec_out=rec_out)
+                    done += last
+                    if written > before:
+                        phi_rec.append(integ.phi)
+            else:
+                done = integ.advance(n, w_k, me_k)[0]
+            done_total += done
+            if bar is not None:
+                bar.update(done)
+            if integ.diverged or done < n:
+                break
+    while hold is None and done_total < n_total:
         n = min(seg_steps, n_total - done_total)
         t_a, t_b = integ.t, integ.t + n * dt_
         if hold is not None:
@@ -732,7 +784,9 @@ def run_transient(
     msg = (
         f"diverged at t = {integ.t:.4f} s: penetration beyond {integ.max_penetration * 1e3:g} mm"
         if integ.diverged
-        else f"completed {t_end:g} s in {done_total} steps of {dt_:.3e} s"
+        else f"completed {t_end:g} s in {done_total} steps of {dt_:.3e} s" if len(steps_used) == 1
+        else (f"completed {t_end:g} s in {done_total} steps of {min(steps_used):.3e}-{max(steps_used):.3e} s (the "
+              f"FMU's plan: each held {hold:g} s in steps within half the stability limit at its speed)")
     )
     wear = None
     if liner is not None:
@@ -740,12 +794,12 @@ def run_transient(
         integ.record_wear(0, None)
         wear = {"t": t0 + (np.arange(k) + 1) * wear_every * dt_, "angles": liner.angles,
                 "profiles": wear_rows[:k].copy(), "depth": liner.depth.copy(), "summary": liner.summary()}
-    final = TransientState(integ.t, integ.q.copy(), integ.q_prev.copy(), integ.phi, integ.steps, dt_,
+    final = TransientState(integ.t, integ.q.copy(), integ.q_prev.copy(), integ.phi, integ.steps, integ.dt,
                            None if liner is None else liner.get_state())
     growth = {**NO_GROWTH, "about": None}
     if not integ.diverged and written >= 4 and t_rec[-1] - t0 >= GROWTH_MIN_RUN_S:
         growth = run_growth(t_rec, q_rec, _static_reference(model, contact, omega, me, liner), t0)
-    return TransientResult(contact.formulation, t_rec, q_rec, om, outs, dt_, integ.dt_limit, integ.diverged,
+    return TransientResult(contact.formulation, t_rec, q_rec, om, outs, min(steps_used), integ.dt_limit, integ.diverged,
                            integ.t, msg, model.params.normalisation.omega_ref, wear, final, growth)
 
 

@@ -95,3 +95,28 @@ def test_quasi_static_map_hatches_unstable_cells_cell_by_cell(monkeypatch, tmp_p
     r = fig.canvas.get_renderer()
     assert not fig.legends[0].get_window_extent(r).overlaps(ax.get_window_extent(r))
     pyplot().close(fig)
+
+
+def test_a_run_up_whose_step_plan_changes_matches_the_library(tmp_path):
+    """Fourteen thicker blades: the stability limit at 1 ms falls from 2 to 3 substeps inside the run-up (between
+    2.4 and 4.2 Omega_ref). The FMU re-plans its substeps per rad/s band and restarts at the same velocity; the
+    library's hold mode follows the same plan (transient.held_substep), so the two run the same steps: before it
+    did, the library kept the top speed's step and the two differed by 2.5e-3."""
+    from fmu_src.models.contact.builder import build_native_fmu
+    from rotorub_model.analyses.transient import held_substep
+    from rotorub_model.contact import make_contact
+    from rotorub_model.structure.model import build_model
+    from rotorub_model.structure.params import REFERENCE_FILE, load_parameters
+
+    text = REFERENCE_FILE.read_text().replace("\ncount = 10 ", "\ncount = 14 ").replace(
+        "\nthickness = 0.011 ", "\nthickness = 0.01265 ")
+    (tmp_path / "b14.toml").write_text(text)
+    model = build_model(load_parameters(tmp_path / "b14.toml"))
+    assert model.params.blades.count == 14
+    w_ref, c = model.params.normalisation.omega_ref, make_contact(model, "3D", g0=1e-3)
+    plans = {round(1e-3 / held_substep(model, c, w_ref * s, 1e-3)) for s in (2.4, 4.2)}
+    assert plans == {2, 3}  # the plan changes inside the run-up
+    fmu = build_native_fmu(tmp_path / "fmu", params_file=tmp_path / "b14.toml", platforms=("linux64",))["fmu"]
+    s = harness.run_up(fmu, model, tmp_path / "ru", speed_from=2.4, speed_to=4.2, duration=6.0, g0=1e-3)
+    assert s["max_normal_force_N"] > 100.0  # it rubs through the critical
+    assert s["max_rel_diff_F_N_vs_library"] < 1e-9 and s["max_rel_diff_disk_vs_library"] < 1e-9
