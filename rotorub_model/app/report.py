@@ -211,8 +211,10 @@ def _wear_section(w: dict) -> list[str]:
 
 
 def _continuation_section(c: dict) -> list[str]:
+    at = (f"at Ω = {c['speed']:.4g} Ω_ref ({c['speed_source']})" if c.get("speed") is not None
+          else "at the section-6 speed")
     lines = ["", "## Continuation: special points, what the instability grows into, the boundary as a curve", "",
-             "Static branches in g0 at the section-6 speed (pseudo-arclength through contact events), their Hopf, "
+             f"Static branches in g0 {at} (pseudo-arclength through contact events), their Hopf, "
              "fold and contact-induced switch points, the periodic orbits past them (shooting with the transient "
              "kernel, Floquet multipliers), and the stability boundary traced as curves over the grid maps "
              "(`rotorub continuation`; `continuation/continuation.png`, `continuation/boundaries.png`).", "",

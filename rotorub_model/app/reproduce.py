@@ -222,8 +222,12 @@ def run_reproduce(model: Model, out: str | Path, quick: bool = False, params_fil
     from .studies import run_continuation_study
 
     with step("continuation", "continuation: branches, special points, orbits, boundary curves"):
-        cont = run_continuation_study(model, out / "continuation", maps_dir=out / "stability", quick=quick,
-                                      progress=progress)
+        # at the section-6 point's speed, so that the branches explain the transients the report shows there (on
+        # a configuration where the transient study picks another speed than the paper's, the two used to differ
+        # with nothing to say why)
+        cont = run_continuation_study(model, out / "continuation", speed=tr["speed"], maps_dir=out / "stability",
+                                      quick=quick, progress=progress,
+                                      speed_source=f"the section-6 transients' speed ({tr['point']['source']})")
     sections = []
     with step("forced_response", "forced response of an oval casing (harmonic balance, quick)"):
         from .forced_response import run_forced_quick

@@ -469,7 +469,8 @@ def run_wear_study(model: Model, out: str | Path, speed: float | None = None, g0
 
 
 def run_continuation_study(model: Model, out: str | Path, speed: float | None = None,
-                           maps_dir: str | Path | None = None, quick: bool = True, progress: bool = True) -> dict:
+                           maps_dir: str | Path | None = None, quick: bool = True, progress: bool = True,
+                           speed_source: str = "given") -> dict:
     """Branches, special points, orbits and boundary curves (``analyses.continuation``) against the
     stability maps of ``maps_dir`` (or the quick maps, computed here)."""
     from ..analyses.continuation import run_continuation
@@ -484,7 +485,7 @@ def run_continuation_study(model: Model, out: str | Path, speed: float | None = 
         if progress:
             say("continuation: no --maps given: computing the quick stability maps first")
         maps = {f: run_stability_map(model, f, speeds, g0s, progress=progress) for f in ("2D", "3D")}
-    r = run_continuation(model, maps=maps, speed=speed, quick=quick, progress=progress)
+    r = run_continuation(model, maps=maps, speed=speed, quick=quick, progress=progress, speed_source=speed_source)
     s = r.save(out)
     for f in ("2D", "3D"):  # the orbits' count per branch, as the report tabulates them
         if f in s:

@@ -129,3 +129,15 @@ def test_main_job_reports_the_quick_forced_response_and_uncertainty(run):
     t = summary["timings_s"]
     assert set(t) >= {"linear", "detection", "stability", "transient", "wear", "continuation", "forced_response",
                       "uncertainty"} and all(v > 0 for v in t.values())
+
+
+def test_the_continuation_runs_at_the_section_6_point_and_says_so(run):
+    """The branches explain the transients at the point the transient study picked: the same speed, its reason in
+    the summary, the value in the report (a configuration whose point is not the paper's speed used to show the
+    branches at 3.3 beside transients at another speed, with nothing to say why)."""
+    out, summary = run
+    c, t = summary["continuation"], summary["transient"]
+    assert c["speed"] == t["speed"]
+    assert c["speed_source"].startswith("the section-6 transients' speed")
+    assert json.loads((out / "continuation" / "summary.json").read_text())["speed_source"] == c["speed_source"]
+    assert f"at Ω = {t['speed']:.4g} Ω_ref (the section-6 transients' speed" in (out / "report.md").read_text()

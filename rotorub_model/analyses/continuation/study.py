@@ -439,16 +439,16 @@ def study_speed(model: Model, speeds: np.ndarray) -> tuple[float, str]:
 def run_continuation(model: Model, maps: dict[str, StabilityMap] | None = None, speeds: np.ndarray | None = None,
                      g0s: np.ndarray | None = None, speed: float | None = None, quick: bool = True,
                      formulations: tuple[str, ...] = FORMULATIONS, boundaries: bool = True,
-                     progress: bool = False) -> ContinuationResult:
+                     progress: bool = False, speed_source: str = "given") -> ContinuationResult:
     """Branches at ``speed`` (normalised; default :func:`study_speed`) in g0 over the map range, orbits,
     and boundary curves over the maps' (or ``speeds`` x ``g0s``) range, compared with the maps when
-    given."""
+    given. ``speed_source``: why a given ``speed`` (what the result's summary says of it)."""
     if maps:
         any_map = next(iter(maps.values()))
         speeds, g0s = any_map.speeds, any_map.g0s
     if speeds is None or g0s is None:
         raise ValueError("speeds and g0s (or maps) are needed: the range of the boundary curves")
-    source = "given"
+    source = speed_source
     if speed is None:
         speed, source = study_speed(model, np.asarray(speeds))
     wref = model.params.normalisation.omega_ref
