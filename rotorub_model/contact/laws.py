@@ -61,8 +61,15 @@ def knee_note(contact: Any, deepest_penetration: float) -> str:
     these are the penalty law's results
     >>> knee_note(c, 4e-4)
     ''
+    >>> knee_note(c, -0.0)
+    "the bilinear law's knee (0.3 mm) was never reached: no blade touched the casing, the contact law played no part"
     """
     if "knee" not in LAWS[contact.law] or deepest_penetration >= contact.knee:
         return ""
+    if deepest_penetration <= 0.0:
+        # no penetration at all: "deepest penetration -0 mm" (a clamped -0.0) read as a number gone wrong, and
+        # "the penalty law's results" as if the contact had acted
+        return (f"the {contact.law} law's knee ({contact.knee * 1e3:.3g} mm) was never reached: no blade touched "
+                "the casing, the contact law played no part")
     return (f"the {contact.law} law's knee ({contact.knee * 1e3:.3g} mm) was never reached (deepest penetration "
-            f"{max(deepest_penetration, 0.0) * 1e3:.3g} mm): these are the penalty law's results")
+            f"{deepest_penetration * 1e3:.3g} mm): these are the penalty law's results")

@@ -12,7 +12,7 @@ from rotorub_model.analyses.energy import energy_history
 from rotorub_model.analyses.static import solve_static
 from rotorub_model.analyses.transient import critical_time_step, run_transient
 from rotorub_model.contact import make_contact
-from rotorub_model.contact.laws import LAWS, law_params, max_slope
+from rotorub_model.contact.laws import LAWS, knee_note, law_params, max_slope
 from rotorub_model.errors import ParameterError
 from rotorub_model.structure.model import build_model
 from rotorub_model.structure.params import load_parameters, reference_parameters
@@ -250,3 +250,17 @@ def test_the_static_verdict_says_when_the_knee_was_never_reached(write_params, t
     out = capsys.readouterr().out
     assert rc == 0
     assert ("the bilinear law's knee (5 mm) was never reached" in out) is noted, out
+
+
+def test_knee_note_without_contact_says_no_blade_touched():
+    """A static solution clear of the casing gives deepest penetration -0.0 (the CLI's gaps.min(initial=0)): the note
+    said "deepest penetration -0 mm ... these are the penalty law's results", a number that looks wrong and a claim
+    that the contact acted. It must say no blade touched; a real shallow penetration keeps its depth."""
+    c = reference_parameters().replace(contact={"law": "bilinear", "knee": 2e-4}).contact
+    for clear in (-0.0, 0.0, -1e-4):
+        note = knee_note(c, clear)
+        assert "no blade touched the casing" in note and "-0" not in note and "penalty law's results" not in note
+    shallow = knee_note(c, 5e-5)
+    assert "deepest penetration 0.05 mm" in shallow and "penalty law's results" in shallow
+    assert knee_note(c, 3e-4) == ""
+    assert knee_note(reference_parameters().contact, -0.0) == ""  # the penalty law has no knee
