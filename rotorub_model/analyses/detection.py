@@ -539,7 +539,8 @@ def paper_facts(s: dict) -> list[dict]:
         condition("contact at g0 = 0 at every speed", s["contact_at_every_speed_at_g0_zero"],
                   "yes" if s["contact_at_every_speed_at_g0_zero"] else "no"),
         condition(f"the largest 2D closure at the first critical (within the grid spacing {tol:.3g})",
-                  abs(off["2D"]) <= tol, f"at Ω = {at['2D']:.4g}, first critical {crit}"),
+                  abs(off["2D"]) <= tol,
+                  f"at Ω = {at['2D']:.4g}, first critical " + ("none" if crit is None else f"{crit:.4g}")),
         condition(f"the largest 3D closure at the first critical (within {tol:.3g})", abs(off["3D"]) <= tol,
                   f"at Ω = {at['3D']:.4g}"),
         condition("the 3D map contains the 2D map", s["map_3d_contains_2d"], "yes" if s["map_3d_contains_2d"] else

@@ -163,6 +163,12 @@ def test_paper_facts_hold(summary):
     assert all(f["holds"] for f in facts), [f["id"] for f in facts if not f["holds"]]
 
 
+def test_paper_facts_conditions_print_rounded_speeds(summary):
+    """The report's and the verdict's "ours" read "first critical 3.492", not the float's 16 digits."""
+    ours = [c["ours"] for c in paper_facts(summary)[0]["conditions"] if "first critical" in c["ours"]]
+    assert ours and all(len(o.split("first critical ")[1]) <= 6 for o in ours), ours
+
+
 # ------------------------------------------------------------------ CLI
 
 
