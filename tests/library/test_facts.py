@@ -54,7 +54,7 @@ def test_the_report_and_the_verdict_list_the_failed_conditions(tmp_path):
     assert "  * three blades touch at 1 s in 2D: ours 4 — a number of the paper's rotor" in part
     lines = main_job_verdict(s, tmp_path, ["FMU checks: ..."])
     assert lines[0] == "Main job on fourteen.toml (quick grids): 2 of 3 paper facts hold (1, 6b)."
-    assert lines[1].startswith("  fact 6a does not hold: three blades touch at 1 s in 2D (ours 4)")
+    assert lines[1].startswith("  fact 6a does not hold: expected three blades touch at 1 s in 2D, ours 4")
     assert lines[1].endswith("numbers of the paper's rotor, not a defect of this configuration")
     assert lines[-1] == f"report: {tmp_path / 'report.md'}; summary: {tmp_path / 'summary.json'}; figures in " \
                         f"{tmp_path}/*/"
