@@ -145,6 +145,7 @@ ERROR_CASES = {
     "thickness > width": (_set(("blades", "thickness"), 0.3), ["blades.thickness", "blades.width"]),
     "chord too long": (_set(("contact", "chord"), 2.5), ["contact.chord", "range"]),
     "interference too deep": (_set(("contact", "g0"), -0.4), ["contact.g0", "range"]),
+    "g0 in mm": (_set(("contact", "g0"), 0.5), ["contact.g0", "0.5 m out of range", "0.1] m", "0.5e-3"]),
 }
 
 
