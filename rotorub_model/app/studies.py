@@ -293,6 +293,19 @@ def _deepest(*runs: TransientResult) -> float:
     return max((float(-np.min(r.outputs["gap"], initial=0.0)) for r in runs), default=0.0)
 
 
+def _law_note(contact, runs: dict[str, TransientResult]) -> str:
+    """The law's note over the study's runs (``knee_note``), naming the formulation when only one of them stayed
+    short of the knee: a 2D run at 0.18 mm and a 3D run at 0.27 mm with a 0.2 mm knee are not both the bilinear
+    law's results, and the note over both (the deeper) said nothing."""
+    if contact is None:
+        return ""
+    notes = {f: knee_note(contact, _deepest(r)) for f, r in runs.items()}
+    short = [f for f, n in notes.items() if n]
+    if len(short) == len(notes):
+        return knee_note(contact, _deepest(*runs.values()))
+    return "; ".join(f"{f}: {notes[f]}" for f in short)
+
+
 @dataclass
 class TransientStudy:
     speed: float
@@ -329,7 +342,7 @@ class TransientStudy:
                 "" if g2["factor"] is not None and g3["factor"] is not None else
                 "a run shorter than 4 s gets no growth verdict: diverged is null unless the penetration limit was hit "
                 "(the envelope's growth is fitted over the second half of a run of at least 4 s)",
-                knee_note(self.contact, _deepest(r2, r3)) if self.contact is not None else "") if n),
+                _law_note(self.contact, {"2D": r2, "3D": r3})) if n),
             "point": self.point.summary() if self.point else {"source": "given"},
             "settled_3d": settled(r3, st3.q) if st3.converged else False,
             "blades_in_contact_2d_at_1s": r2.blades_in_contact(i2),

@@ -114,3 +114,26 @@ def test_a_run_too_short_to_judge_gets_no_verdict(tmp_path):
     s = run_transient_study(build_model(), tmp_path, 3.3, 0.3347658066492542e-3, t_end=2.0, progress=False)
     assert s["diverged_2d"] is None and s["diverged_3d"] is None and "shorter than 4 s" in s["verdict_note"]
     assert s["static_2d"]["max_real_part"] > 0.1
+
+
+# ------------------------------------------------------------------------------------------- the law's note
+def test_law_note_names_the_formulation_that_stayed_short_of_the_knee():
+    """A bilinear knee of 0.2 mm, a 2D run 0.176 mm deep and a 3D run 0.274 mm deep (configuration A of a user:
+    18 blades, mu 0.2): the note over both said nothing, yet the 2D run is the penalty law's."""
+    from types import SimpleNamespace
+
+    from rotorub_model.app.studies import _law_note
+
+    c = reference_parameters().replace(contact={"law": "bilinear", "knee": 2e-4}).contact
+
+    def run(depth):
+        return SimpleNamespace(outputs={"gap": np.array([[1e-3, -depth], [2e-4, 0.0]])})
+
+    note = _law_note(c, {"2D": run(1.76e-4), "3D": run(2.74e-4)})
+    assert note.startswith("2D: the bilinear law's knee (0.2 mm) was never reached (deepest penetration 0.176 mm)")
+    assert "3D" not in note
+    assert _law_note(c, {"2D": run(3e-4), "3D": run(2.74e-4)}) == ""
+    both = _law_note(c, {"2D": run(1e-4), "3D": run(1.5e-4)})
+    assert not both.startswith(("2D", "3D")) and "deepest penetration 0.15 mm" in both
+    assert _law_note(reference_parameters().contact, {"2D": run(1e-4), "3D": run(1e-4)}) == ""  # no knee
+    assert _law_note(None, {"2D": run(1e-4)}) == ""
