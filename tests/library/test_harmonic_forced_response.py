@@ -22,7 +22,8 @@ def test_forced_response_writes_the_map_and_says_where_hb_and_transients_disagre
         assert (out / name).read_bytes()[:8] == PNG_MAGIC
     s = json.loads((out / "interaction_map.json").read_text())
     assert s["forcing"]["lobes"]["2"]["amplitude_m"] == 0.15e-3
-    assert s["branch_message"].endswith("reached omega = 173.55")
+    assert s["branch_message"].endswith("reached omega = 173.55 rad/s")
+    assert s["branch_message"].startswith("from omega = 160.2 rad/s: ")  # 3.0 Omega_ref, with its unit
     ag = {round(a["speed"], 3): a for a in s["agreement"]}
     assert ag[3.0]["verdict"] == "agree" and ag[3.0]["transient"] == "periodic"
     assert ag[3.25]["verdict"] == "disagree" and "not settled" in ag[3.25]["why"]

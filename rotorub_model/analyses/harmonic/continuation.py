@@ -180,7 +180,7 @@ def continue_hb(problem: HBProblem, parameter: str, start: float, stop: float, f
                 Y0: np.ndarray | None = None, h_max: float = 0.05, max_points: int = 2000, stability: bool = True,
                 substeps: float | None = DEFAULT_SUBSTEPS, progress=None, autonomous: bool = False,
                 w0: float | None = None, start_tangent: tuple[np.ndarray, float, float] | None = None,
-                y_scale: float | None = None, halt=None) -> HBBranch:
+                y_scale: float | None = None, halt=None, unit: str = "") -> HBBranch:
     """Follow the HB orbit from ``parameter = start`` to ``stop`` (``omega`` [rad/s] at g0 = ``fixed``, or
     ``g0`` [m] at Omega = ``fixed``). ``h_max``: the largest step as a fraction of the range (and of y_s).
 
@@ -188,7 +188,9 @@ def continue_hb(problem: HBProblem, parameter: str, start: float, stop: float, f
     phase condition fixes its time origin (:func:`.autonomous.phase_index`: the sine of harmonic 1 of the
     coordinate that moves most vanishes); ``start_tangent`` (dY, dw, dp) starts the branch at (Y0, w0) as it is
     (a Hopf point: the static solution, any w) along that direction, instead of a Newton solve there.
-    ``halt(point) -> str | None``: a reason to end the branch at this point (the map's bound on the amplitude)."""
+    ``halt(point) -> str | None``: a reason to end the branch at this point (the map's bound on the amplitude).
+    ``unit``: the parameter's unit in the branch's message ("rad/s" for a model's speed; "" for the
+    non-dimensional oscillators)."""
     if parameter not in ("omega", "g0"):
         raise ParameterError(f"parameter: '{parameter}' unknown; accepted: omega, g0")
     if not (math.isfinite(start) and math.isfinite(stop)) or start == stop:
@@ -196,6 +198,8 @@ def continue_hb(problem: HBProblem, parameter: str, start: float, stop: float, f
     if autonomous and (Y0 is None or w0 is None):
         raise ParameterError("autonomous: needs a start Y0 and its frequency w0 (an orbit, or a Hopf point's "
                              "static solution with start_tangent)")
+    # the branch's message is read in verdicts ("reached omega = 240.3" left a structures engineer guessing rpm)
+    unit = f" {unit}" if unit else ""
     pb = problem
     om, w, g0 = (start, start, fixed) if parameter == "omega" else (fixed, fixed, start)
     if autonomous:
@@ -245,7 +249,7 @@ def continue_hb(problem: HBProblem, parameter: str, start: float, stop: float, f
         if z_new is None:
             h *= 0.5
             if h < 1e-7:
-                message = f"the corrector failed at {parameter} = {tr.unpack(z)[1]:.6g} (step below 1e-7)"
+                message = f"the corrector failed at {parameter} = {tr.unpack(z)[1]:.6g}{unit} (step below 1e-7)"
                 break
             continue
         p_old, p_new = tr.unpack(z)[1], tr.unpack(z_new)[1]
@@ -268,7 +272,7 @@ def continue_hb(problem: HBProblem, parameter: str, start: float, stop: float, f
         z, t, det_sign = z_new, t_new, sign_new
         reason = halt(new) if halt is not None else None
         if reason:
-            message = f"stopped at {parameter} = {tr.unpack(z)[1]:.6g}: {reason}"
+            message = f"stopped at {parameter} = {tr.unpack(z)[1]:.6g}{unit}: {reason}"
             complete = False
             break
         if complete:
@@ -277,7 +281,7 @@ def continue_hb(problem: HBProblem, parameter: str, start: float, stop: float, f
     else:
         message = f"stopped after {max_points} points"
     if complete:
-        message = f"reached {parameter} = {stop:.6g}"
+        message = f"reached {parameter} = {stop:.6g}{unit}"
     return HBBranch(parameter, pts, specials, complete, message)
 
 

@@ -412,12 +412,13 @@ def follow_segments(problem: HBProblem, start: float, stop: float, g0: float, ha
     pts, specials, msgs, seg = [], [], [], []
     Y0, s0 = None, start
     while True:
-        br = continue_hb(problem, "omega", s0, stop, g0, Y0=Y0, max_points=max_points, progress=progress, halt=halt)
+        br = continue_hb(problem, "omega", s0, stop, g0, Y0=Y0, max_points=max_points, progress=progress, halt=halt,
+                         unit="rad/s")
         k = len(msgs)
         pts += br.points
         specials += br.specials
         seg += [k] * len(br.points)
-        msgs.append(f"[{s0:.4g}, ...]: {br.message}")
+        msgs.append(f"from omega = {s0:.4g} rad/s: {br.message}")
         if br.complete or not br.points:
             break
         reached = max(p.omega for p in br.points)
