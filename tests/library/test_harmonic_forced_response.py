@@ -41,3 +41,18 @@ def test_forced_response_bad_input(tmp_path, capsys):
         err = capsys.readouterr().err.strip().splitlines()
         assert rc == 2 and len(err) == 1 and needle in err[0], (args, err)
     assert not (tmp_path / "x").exists() or not any((tmp_path / "x").iterdir())
+
+
+def test_forced_response_figure_names_the_special_points():
+    """The legend names each kind of special point once, in words ("HB change of stability", not "HB stability",
+    which read as a state): 2D, g0 0.5 mm, the oval of the main job from 3 to 4.5 Omega_ref (two stability changes and
+    six folds on the reference), without transients (4 s)."""
+    from rotorub_model.analyses.harmonic.interaction import run_interaction_map
+    from rotorub_model.structure.model import build_model
+
+    r = run_interaction_map(build_model(), "2D", (3.0, 4.5), g0=0.5e-3, n_transients=0, wear=False, progress=False)
+    kinds = {s.kind for s in r.branch.specials}
+    assert kinds == {"stability", "fold"}
+    labels = r.figure().axes[0].get_legend_handles_labels()[1]
+    assert labels.count("HB change of stability") == 1 and labels.count("HB fold") == 1, labels
+    assert "HB stability" not in labels

@@ -177,7 +177,8 @@ class InteractionMap:
             i = int(np.argmin(np.abs(s - sp.point.omega / self.omega_ref)))
             mk = {"fold": "s", "branch": "D", "stability": "o"}[sp.kind]
             axes[0].plot(sp.point.omega / self.omega_ref, self.hb["tip_amplitude"][i] * 1e3, mk, mfc="none",
-                         color="k", ms=6, label=f"HB {sp.kind}" if sp.kind not in _labelled(axes[0]) else None)
+                         color="k", ms=6,
+                         label=None if SPECIAL_LABELS[sp.kind] in _labelled(axes[0]) else SPECIAL_LABELS[sp.kind])
         tr = self.transients
         if tr.get("speed") is not None and len(tr["speed"]):
             kinds = np.array([KINDS[int(k)] for k in tr["kind"]])
@@ -267,7 +268,7 @@ class InteractionMap:
 
 
 def _labelled(ax) -> set:
-    return {t.replace("HB ", "") for t in ax.get_legend_handles_labels()[1]}
+    return set(ax.get_legend_handles_labels()[1])
 
 
 def _forcing_text(f: CasingForcing) -> str:
@@ -396,6 +397,10 @@ def tip_cap(model: Model, problem: HBProblem, contact) -> callable:
                                         "(beyond the model's range: the map restarts past this speed)")
     return halt
 
+
+# the legend's words for the branch's special points ("HB stability" alone read as a state, not a point where it
+# changes)
+SPECIAL_LABELS = {"fold": "HB fold", "branch": "HB branch point", "stability": "HB change of stability"}
 
 BLAS_THREADS_FROM = 1500  # unknowns of the balance from which the branch's dense algebra uses every core
 
