@@ -502,6 +502,12 @@ def run_growth(t: np.ndarray, q: np.ndarray, q_static: np.ndarray | None, t_star
     return {**envelope_growth(t, q, kind="ptp", t_start=t_start), "about": "the oscillation (peak to peak)"}
 
 
+# a run still oscillating at its end (TransientResult.force_swing): a blade's normal force swinging by more than 5 %
+# of its highest value over the last 2 s (the reference's settled 3D run: 0.1 %; a limit cycle: 50 %)
+SWING_WINDOW_S = 2.0
+SWING_MIN_REL = 0.05
+
+
 @dataclass
 class TransientResult:
     formulation: str
@@ -545,7 +551,25 @@ class TransientResult:
             return f"no growth verdict (a run shorter than {GROWTH_MIN_RUN_S:g} s)"
         what = (f"envelope about {g['about']} ×{g['factor']:.3g} over {g['window_s'][0]:.3g}-{g['window_s'][1]:.3g} s "
                 f"({g['rate_per_s']:+.3g} 1/s)")
-        return ("diverged: " if self.envelope_growing else "not diverging: ") + what
+        if self.envelope_growing:
+            return "diverged: " + what
+        swing = self.force_swing()
+        # a flat envelope is not a settled rub: a limit cycle that swings a blade's force 90-181 N for ever read
+        # "not diverging" like a run at rest on its static solution
+        return "not diverging: " + what + (f"; not settled: F_N still swings {swing[0]:.3g}-{swing[1]:.3g} N over "
+                                           f"the last {SWING_WINDOW_S:g} s" if swing else "")
+
+    def force_swing(self) -> tuple[float, float] | None:
+        """(lowest, highest) normal force [N] of the blade whose force swings most over the run's last
+        SWING_WINDOW_S, where that swing exceeds SWING_MIN_REL of its highest value (the run still oscillates:
+        a limit cycle or ringing not yet gone); None where the forces have settled, or the run is too short."""
+        F = self.outputs.get("F_N")
+        if F is None or F.size == 0 or self.t[-1] - self.t[0] < 2 * SWING_WINDOW_S:
+            return None
+        last = F[self.t >= self.t[-1] - SWING_WINDOW_S]
+        j = int(np.argmax(np.ptp(last, axis=0)))
+        lo, hi = float(last[:, j].min()), float(last[:, j].max())
+        return (lo, hi) if hi > 0.0 and hi - lo > SWING_MIN_REL * hi else None
 
     def summary(self) -> dict:
         o = self.outputs
@@ -566,6 +590,9 @@ class TransientResult:
             "final_normal_forces_N": o["F_N"][-1] if len(o["F_N"]) else [],
             "final_chord_fractions": o["fraction"][-1] if len(o["fraction"]) else [],
             "max_normal_force_N": float(o["F_N"].max()) if o["F_N"].size else 0.0,
+            # [lowest, highest] F_N [N] of the blade swinging most over the last 2 s where it still swings; null
+            # where the forces have settled
+            "force_swing_last_s_N": list(sw) if (sw := self.force_swing()) else None,
         }
 
     def figure(self, title: str = ""):

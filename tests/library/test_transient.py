@@ -114,3 +114,25 @@ def test_record_arrays_are_zeros_the_kernel_can_write(n_rec):
     assert not out.any()
     if n_rec * 106 * 8 >= POPULATE_FROM_BYTES:
         assert q.base is not None and out.base is q.base  # one block
+
+
+def test_a_limit_cycle_is_not_called_settled(ref_model):
+    """A user's 8-blade fan (casing suspension halved, k_r doubled, mu 0.05) at its picked section-6 point: the 2D
+    static solution is unstable (+0.16 1/s) and the run saturates into a limit cycle, blade 5's force swinging about
+    90-181 N for ever. Its envelope neither grows nor decays, and the verdict said only "not diverging", as for a
+    run at rest. It must say the force still swings; the same point's 3D run, which settles, must not."""
+    from rotorub_model.structure.model import build_model
+
+    p = ref_model.params
+    m = build_model(p.replace(blades={"count": 8}, contact={"k_r": 3.0e6, "mu": 0.05},
+                              suspension={"k_translation": 2.5e7, "k_rotation": 1.0e7}))
+    w = 4.108 * m.params.normalisation.omega_ref
+    r2 = run_transient(m, make_contact(m, "2D", g0=0.2587e-3), w, t_end=20.0, progress=False)
+    assert r2.diverged is False
+    lo, hi = r2.force_swing()
+    assert 60.0 < lo < 120.0 and 150.0 < hi < 220.0, (lo, hi)
+    assert r2.verdict().startswith("not diverging: ") and "not settled: F_N still swings" in r2.verdict()
+    assert r2.summary()["force_swing_last_s_N"] == [lo, hi]
+    r3 = run_transient(m, make_contact(m, "3D", g0=0.2587e-3), w, t_end=20.0, progress=False)
+    assert r3.diverged is False and r3.force_swing() is None and "not settled" not in r3.verdict()
+    assert r3.summary()["force_swing_last_s_N"] is None
