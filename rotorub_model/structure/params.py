@@ -169,7 +169,7 @@ class ContactParams:
                                     "structure and the penalty law means nothing)")
     law: str = field(default="penalty", metadata={
         "choices": ("penalty", "bilinear"),
-        "doc": "normal contact law (docs/THEORY.md 4.2): penalty (the paper's, F = k_r delta) or bilinear (a coating "
+        "doc": "normal contact law (docs/THEORY.md 4.0): penalty (the paper's, F = k_r delta) or bilinear (a coating "
                "then a stiffer or softer layer: F = k_r delta + (stiffness_ratio - 1) k_r (delta - knee)_+)"})
     knee: float = _f(1e-6, 0.05, default=0.5e-3,
                      doc="bilinear law: the penetration where the stiffness changes [m] (default 0.5 mm: a thin "
