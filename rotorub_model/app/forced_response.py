@@ -21,6 +21,9 @@ def forcing_from_args(g0: float, lobe: int | None, amplitude: float | None, phas
             raise ParameterError("--amplitude: needed with --lobe (the lobe's amplitude a_n [m])")
         f = CasingForcing(lobes={int(lobe): (float(amplitude), math.radians(phase_deg))},
                           offset=offset or (0.0, 0.0))
+    elif amplitude is not None:
+        # without it the amplitude was dropped and the default oval (0.3 g0) run instead, the verdict naming it
+        raise ParameterError(f"--lobe: needed with --amplitude {amplitude:g} (the lobe count n >= 2 it belongs to)")
     elif offset is not None and any(offset):
         f = CasingForcing(offset=offset)
     else:

@@ -35,6 +35,7 @@ def test_forced_response_writes_the_map_and_says_where_hb_and_transients_disagre
 def test_forced_response_bad_input(tmp_path, capsys):
     for args, needle in ((["--lobe", "1", "--amplitude", "1e-4"], "lobes: 1 is the casing's rigid offset"),
                          (["--lobe", "2"], "--amplitude"),
+                         (["--amplitude", "0.1mm"], "--lobe: needed with --amplitude 0.0001"),
                          (["--lobe", "2", "--amplitude", "0.02"], "clearances"),
                          (["--harmonics", "1", "--lobe", "2", "--amplitude", "1e-4"], "fewer than the casing's lobe")):
         rc = main(["forced-response", "--out", str(tmp_path / "x"), "--speeds", "3.0", "3.1", *args])
