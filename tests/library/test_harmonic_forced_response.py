@@ -57,3 +57,6 @@ def test_forced_response_figure_names_the_special_points():
     labels = r.figure().axes[0].get_legend_handles_labels()[1]
     assert labels.count("HB change of stability") == 1 and labels.count("HB fold") == 1, labels
     assert "HB stability" not in labels
+    verdict = r.summary()["verdict"]
+    assert "no transients beside it" in verdict and "no disagreement" not in verdict and "at 0 speeds" not in verdict
+    assert "8 special points;" in verdict

@@ -137,15 +137,20 @@ class InteractionMap:
         rel = [abs(r["relative_difference"]) for r in ag if "relative_difference" in r]
         kinds = [KINDS[int(k)] for k in self.transients.get("kind", [])]
         dis = self.disagreements()
+        ns = len(b.specials)
         verdict = (f"{self.formulation}, g0 = {self.g0 * 1e3:.3g} mm, casing {_forcing_text(self.forcing)}: HB "
                    f"branch of {len(b.points)} orbits ({b.message}), {int(np.sum(~self.hb['stable']))} unstable, "
-                   f"{len(b.specials)} special points; transients ({self.t_end:g} s) at {len(kinds)} speeds: "
-                   f"{sum(k == 'periodic' for k in kinds)} periodic, {sum(k == 'settling' for k in kinds)} not "
-                   f"settled, {sum(k not in ('periodic', 'settling') for k in kinds)} not periodic; "
-                   + (f"HB-transient amplitudes within {100 * max(rel):.2g} % where both are periodic; "
-                      if rel else "no speed where both are periodic; ")
-                   + (f"HB and transient DISAGREE at {len(dis)} speed(s): "
-                      + "; ".join(f"{r['speed']:.3g}: {r['why']}" for r in dis) if dis else "no disagreement"))
+                   f"{ns} special point{'' if ns == 1 else 's'}; "
+                   # without transients there is nothing to agree or disagree with: "transients at 0 speeds: 0
+                   # periodic ...; no disagreement" read as a check that passed
+                   + ("no transients beside it (--transients K runs them at K speeds)" if not kinds else
+                      f"transients ({self.t_end:g} s) at {len(kinds)} speeds: "
+                      f"{sum(k == 'periodic' for k in kinds)} periodic, {sum(k == 'settling' for k in kinds)} not "
+                      f"settled, {sum(k not in ('periodic', 'settling') for k in kinds)} not periodic; "
+                      + (f"HB-transient amplitudes within {100 * max(rel):.2g} % where both are periodic; "
+                         if rel else "no speed where both are periodic; ")
+                      + (f"HB and transient DISAGREE at {len(dis)} speed(s): "
+                         + "; ".join(f"{r['speed']:.3g}: {r['why']}" for r in dis) if dis else "no disagreement")))
         return {"formulation": self.formulation, "g0_m": self.g0, "forcing": self.forcing.summary(),
                 "harmonics": self.harmonics, "omega_ref_rad_s": self.omega_ref, "branch_message": b.message,
                 "points": len(b.points), "specials": [s.summary() for s in b.specials],
