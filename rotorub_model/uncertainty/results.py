@@ -82,9 +82,10 @@ class UQResult:
         if s.model != "rotorub":
             return "the test function"
         if s.speeds is not None:
-            return f"a run-up over speeds {s.speeds[0]:g}-{s.speeds[1]:g} ({s.formulation})"
+            return f"a run-up over speeds {s.speeds[0]:g}-{s.speeds[1]:g} Ω_ref ({s.formulation})"
         first = ", the first critical" if s.speed == "first_critical" else ""
-        return f"speed {self.speeds[0]:.4g} ({s.formulation}{first})"
+        # the speed is normalised: the unit says so (a bare "speed 3.455" read as a number of what?)
+        return f"speed {self.speeds[0]:.4g} Ω_ref ({s.formulation}{first})"
 
     def clearance_for(self, p_target: float = TARGET_P) -> float | None:
         """The smallest build clearance whose rub probability's upper bound is at most p_target (None when the

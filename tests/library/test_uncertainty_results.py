@@ -26,7 +26,7 @@ def test_montecarlo_result_saves_its_figures_and_json(tmp_path):
     for k in r.figures:
         assert (tmp_path / f"uq_{k}.png").stat().st_size > 10_000
     on_disk = json.loads((tmp_path / "uq_summary.json").read_text())
-    assert on_disk["verdict"] == s["verdict"] and s["verdict"].startswith("P(rub) at speed 3.3 (3D) = ")
+    assert on_disk["verdict"] == s["verdict"] and s["verdict"].startswith("P(rub) at speed 3.3 Ω_ref (3D) = ")
     p = on_disk["estimates"]["probabilities"]
     assert p["rub"]["probability"] <= p["margin < 0.2e-3"]["probability"]  # the events are nested
     z = np.load(tmp_path / "uq_samples.npz")
