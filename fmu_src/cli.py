@@ -45,9 +45,15 @@ def _run_build(ns: argparse.Namespace) -> dict:
         raise ParameterError(f"build-fmu: {exc}") from None
     plats = r.get("platforms") or r.get("kernel_platforms") or []
     flavour = ("native C, FMI 3.0" if ns.fmi3 else "native C, FMI 2.0") if ns.native else "pythonfmu, FMI 2.0"
+    from rotorub_model.structure.params import load_parameters
+
+    # which model is built in: the same file name holds the reference or a user's fan, and a build from
+    # `--params` replaced fmus/native/ without a word
+    blades = load_parameters(ns.params).blades.count
     r["verdict"] = [f"Built {r['fmu']} ({flavour} co-simulation, mode {ns.mode}"
                     + (f", {r['variables']} variables" if "variables" in r else "")
-                    + (f", binaries for {', '.join(plats)}" if plats else "") + ").",
+                    + (f", binaries for {', '.join(plats)}" if plats else "") + ") with the model of "
+                    + (f"{ns.params}" if ns.params else "the embedded reference") + f" built in ({blades} blades).",
                     f"cross-check kit next to it: {', '.join(Path(k).name for k in r.get('crosscheck_kit', []))}"]
     return r
 
