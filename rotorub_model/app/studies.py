@@ -152,6 +152,18 @@ def pick_transient_point(model: Model, stab_dir: str | Path | None = None, maps:
 
 def choose_transient_point(model: Model, stab_dir: str | Path | None = None, maps: dict | None = None,
                            progress: bool = False, t_end: float = 20.0) -> TransientPoint:
+    """:func:`_choose_transient_point` on one BLAS thread: its hundreds of static solutions and eigenvalue problems
+    are small (38-160 dofs) and gain nothing from threads, while OpenBLAS's thread per core, spinning against other
+    work on a loaded machine, made it 8x slower (an 18-blade configuration, load 5 on 2 cores: 44.6 s against 5.5 s
+    on one thread). A sweep's workers limit their own (analyses/sweeps.py)."""
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1):
+        return _choose_transient_point(model, stab_dir, maps, progress, t_end)
+
+
+def _choose_transient_point(model: Model, stab_dir: str | Path | None, maps: dict | None, progress: bool,
+                            t_end: float) -> TransientPoint:
     """A point where the 2D static solution is unstable and the 3D one stable, from this configuration, where a
     run of t_end shows the 2D instability (its growth e^(Re lambda t_end / 2) over the run's second half, the
     verdict's measure, reaches DIVERGENCE_GROWTH with a margin of 2 on the rate). Candidates, in order; the
