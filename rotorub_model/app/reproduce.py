@@ -312,6 +312,12 @@ def main_job_verdict(s: dict, out: str | Path, fmu_lines: list[str], fmu: bool =
             lines.append(f"  fact {f['id']} does not hold: " + "; ".join(f"expected {c['condition']}, ours {c['ours']}"
                                                                         for c in failed)
                          + (" - numbers of the paper's rotor, not a defect of this configuration" if rotor else ""))
+    # what the section-6 study said about its own runs (a law's knee one of them never reached, a point whose 2D
+    # instability the run may not show): in the study's JSON and on stderr only, so a main job's reader missed it
+    tr = s.get("transient") or {}
+    for note in (tr.get("verdict_note"), (tr.get("point") or {}).get("note")):
+        if note:
+            lines.append(f"  section-6 transients: {note}")
     if fmu:
         lines += fmu_lines or ["FMU checks: none reported"]
     else:

@@ -58,3 +58,17 @@ def test_the_report_and_the_verdict_list_the_failed_conditions(tmp_path):
     assert lines[1].endswith("numbers of the paper's rotor, not a defect of this configuration")
     assert lines[-1] == f"report: {tmp_path / 'report.md'}; summary: {tmp_path / 'summary.json'}; figures in " \
                         f"{tmp_path}/*/"
+
+
+def test_the_verdict_carries_the_section_6_notes(tmp_path):
+    """A bilinear law's knee that the 2D run never reached, and a picked point whose instability the run may not
+    show, were in transient/summary.json and on stderr only: the main job's verdict now says them."""
+    facts = [fact1({"critical_speeds": [3.49, 8.36], "peak_amplitudes_m": [5e-3, 2e-4]})]
+    s = {"paper_facts": facts, "inputs": {"parameters": {"source": "a.toml"}, "grid": {"mode": "quick"}},
+         "transient": {"verdict_note": "2D: the bilinear law's knee (0.2 mm) was never reached",
+                       "point": {"note": "no qualifying point of this configuration has a 2D instability fast enough"}}}
+    lines = main_job_verdict(s, tmp_path, [])
+    assert "  section-6 transients: 2D: the bilinear law's knee (0.2 mm) was never reached" in lines
+    assert any(ln.startswith("  section-6 transients: no qualifying point") for ln in lines)
+    s["transient"] = {"verdict_note": "", "point": {"source": "given"}}
+    assert not any("section-6" in ln for ln in main_job_verdict(s, tmp_path, []))
