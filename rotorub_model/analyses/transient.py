@@ -546,7 +546,8 @@ class TransientResult:
         """The run's outcome in words (the figure's title and the console's line)."""
         g = self.envelope_growth
         if self.penetration_limit_hit:
-            return f"diverged: {self.message}"
+            # the run's message already says "diverged at t = ..." ("diverged: diverged at" read as a stutter)
+            return self.message if self.message.startswith("diverged") else f"diverged: {self.message}"
         if g.get("factor") is None:
             return f"no growth verdict (a run shorter than {GROWTH_MIN_RUN_S:g} s)"
         what = (f"envelope about {g['about']} ×{g['factor']:.3g} over {g['window_s'][0]:.3g}-{g['window_s'][1]:.3g} s "

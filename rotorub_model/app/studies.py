@@ -351,7 +351,9 @@ class TransientStudy:
             "envelope_growth": {"2D": g2, "3D": g3},
             "verdicts": {"2D": r2.verdict(), "3D": r3.verdict()},
             "verdict_note": "; ".join(n for n in (
-                "" if g2["factor"] is not None and g3["factor"] is not None else
+                # only a run that neither hit the penetration limit nor lasted 4 s lacks a verdict: one stopped by
+                # the limit at 6.3 s has no growth fit but is diverged, and the note told its reader otherwise
+                "" if all(g["factor"] is not None or r.penetration_limit_hit for g, r in ((g2, r2), (g3, r3))) else
                 "a run shorter than 4 s gets no growth verdict: diverged is null unless the penetration limit was hit "
                 "(the envelope's growth is fitted over the second half of a run of at least 4 s)",
                 _law_note(self.contact, {"2D": r2, "3D": r3})) if n),

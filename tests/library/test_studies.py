@@ -157,3 +157,16 @@ def test_the_picker_solves_on_one_blas_thread(monkeypatch):
     with threadpool_limits(limits=2):  # a user's process: a thread per core (the suite's conftest pins one)
         studies.choose_transient_point(build_model())
     assert seen and all(s <= {1} for s in seen), seen
+
+
+def test_a_run_stopped_by_the_penetration_limit_gets_no_short_run_note(tmp_path):
+    """A user's 18-blade fan with a bilinear law (knee 0.025 mm) at its picked point (3.3, 0.3815 mm): the 2D run hits
+    the penetration limit at 6.3 s. It has no growth fit, and the study's note said "a run shorter than 4 s gets no
+    growth verdict: diverged is null" about a run that is diverged and ran 6.3 s."""
+    p = reference_parameters().replace(
+        blades={"count": 18, "width": 0.16, "thickness": 0.0099}, casing={"E": 9.1e10},
+        contact={"mu": 0.2, "chord": 0.16, "g0": 0.5e-3, "law": "bilinear", "knee": 0.025e-3})
+    s = run_transient_study(build_model(p), tmp_path, speed=3.3, g0=0.38146673364111827e-3, progress=False)
+    assert s["penetration_limit_hit"]["2D"] is True and s["diverged_2d"] is True
+    assert "shorter than 4 s" not in s["verdict_note"], s["verdict_note"]
+    assert s["verdicts"]["2D"].startswith("diverged at t = ")

@@ -54,6 +54,7 @@ def test_through_the_liner_is_the_penetration_limit(ref_model):
     assert tr.penetration_limit_hit is True and tr.diverged is True and tr.envelope_growing is None
     s = tr.summary()
     assert s["penetration_limit_hit"] is True and s["diverged"] is True and "penetration" in s["message"]
+    assert tr.verdict().startswith("diverged at t = ") and "diverged: diverged" not in tr.verdict()
 
 
 def test_a_run_without_a_static_solution_is_measured_peak_to_peak(ref_model):
