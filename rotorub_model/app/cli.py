@@ -96,6 +96,7 @@ def resolve_defaults(ns: argparse.Namespace, p) -> None:
         ns.speed = first_critical(build_model(p))[0]
     if ns.command == "static" and ns.g0 is None:
         ns.g0 = p.contact.g0
+        ns.g0_from_file = True  # a refusal then names the file's field, not a flag the user never gave
 
 
 def check_arguments(ns: argparse.Namespace, p) -> None:
@@ -133,8 +134,12 @@ def check_arguments(ns: argparse.Namespace, p) -> None:
     g0_max = accepted_range("g0_max")[1]
     v = getattr(ns, "g0", None)
     if v is not None and not (math.isfinite(v) and -p.contact.max_penetration <= v <= g0_max):
-        bad("g0", v, f"[{-p.contact.max_penetration:g}, {g0_max:g}] m (down to an interference as deep as "
-            "contact.max_penetration)")
+        accepted = (f"[{-p.contact.max_penetration:g}, {g0_max:g}] m (down to an interference as deep as "
+                    "contact.max_penetration)")
+        if getattr(ns, "g0_from_file", False):
+            raise ParameterError(f"contact.g0 of the parameter file (the default of --g0): {v!r} m out of range; "
+                                 f"accepted {accepted}")
+        bad("g0", v, accepted)
     for name, declared in (("closure", "clearance_closure"), ("offset_x", "casing_offset"),
                            ("offset_y", "casing_offset")):
         v = getattr(ns, name, None)

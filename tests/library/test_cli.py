@@ -78,6 +78,23 @@ def test_a_length_with_an_unknown_unit_is_one_line(tmp_path):
     assert len(lines) == 1 and "--g0" in lines[0] and "0.3mm" in lines[0]
 
 
+def test_a_file_clearance_out_of_the_cli_range_names_the_file_field(tmp_path, capsys):
+    """contact.g0 = -10 mm in a parameter file loads (an interference down to half a blade), but static refuses it
+    beyond -max_penetration: the line named '--g0', a flag the user never gave; it names the file's field now, and
+    a given --g0 keeps its name."""
+    from rotorub_model.structure.params import reference_parameters, to_toml
+
+    params = tmp_path / "deep.toml"
+    params.write_text(to_toml(reference_parameters().replace(contact={"g0": -0.01})))
+    code, _, err = _run(capsys, "static", "--params", str(params), "--speed", "3.3", "--out", str(tmp_path / "x"))
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and "contact.g0 of the parameter file" in lines[0], lines
+    assert "--g0:" not in lines[0] and "[-0.003, 0.1] m" in lines[0]
+    code, _, err = _run(capsys, "static", "--params", str(params), "--speed", "3.3", "--g0=-5mm", "--out",
+                        str(tmp_path / "y"))
+    assert code == 2 and err.strip().startswith("rotorub static: error: --g0: -0.005 out of range")
+
+
 def test_every_length_option_states_its_unit():
     """--g0-max-mm took millimetres where --g0 took metres: every length option now takes metres or a stated
     unit, and says so in its help; --g0-max-mm stays, named as the same length in millimetres."""
