@@ -307,8 +307,8 @@ def test_thirty_blades_2d_boundaries_meet_at_their_corners():
     assert a["contradicting_beyond_one_cell"] - a["contradicting_beyond_one_cell_off_branch"] == 0, a
 
 
-@pytest.mark.slow  # the imported fan blade (158 dofs): a 6 x 8 corner of its quick 3D map and its curves, twice,
-# 80-300 s on two shared cores (measured); the whole example's map and curves take 12 min
+@pytest.mark.slow  # the imported fan blade (158 dofs): a 6 x 8 corner of its quick 3D map and its curves, twice:
+# 22 s on two shared cores, up to 5 min when they are loaded (measured); the whole example's map and curves take 12 min
 def test_boundaries_the_lattice_misses_are_seeded_from_the_maps_verdicts():
     """The imported fan blade (examples/fan_blade), 3D: by the left edge of the quick map, below g0 = 0.1 mm, two
     modes' Hopf curves (258 and 291 rad/s, Re within 0.05 /s of zero) bound a thin stable sliver; the quick grid's
