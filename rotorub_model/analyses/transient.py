@@ -368,8 +368,11 @@ def rotate_to_fixed(v: np.ndarray, phi: np.ndarray | float) -> np.ndarray:
 # A run's records, written once front to back by the kernel, from this size on are mapped with their pages present
 # (Linux's MAP_POPULATE: one call instead of a page fault at each page's first write). A 2.5 s run recording every
 # 1 ms writes 2.1 MB; on this project's 2-core VM its 520 faults cost 0.6 ms of a 10 ms run (6 %), one call 0.36 ms
-# for all of them (benchmarks/bench_transient.py). Below it, and where the flag does not exist, numpy's zeros.
+# for all of them (benchmarks/bench_transient.py). Below it, and where the flag does not exist, numpy's zeros. Up to
+# POPULATE_UP_TO_BYTES only: populated pages are memory taken at the start, and a long run that diverges early would
+# hold all of them (lazy pages cost the same faults per page written, whatever the run's length).
 POPULATE_FROM_BYTES = 1 << 20
+POPULATE_UP_TO_BYTES = 64 << 20
 
 
 def record_arrays(n_rec: int, n_dofs: int, n_out: int) -> tuple[np.ndarray, np.ndarray]:
@@ -377,7 +380,7 @@ def record_arrays(n_rec: int, n_dofs: int, n_out: int) -> tuple[np.ndarray, np.n
     memory (see POPULATE_FROM_BYTES). The arrays keep the block alive; it is unmapped with the last of them."""
     size = n_rec * (n_dofs + n_out)
     populate = getattr(mmap, "MAP_POPULATE", None)
-    if populate is None or size * 8 < POPULATE_FROM_BYTES:
+    if populate is None or not POPULATE_FROM_BYTES <= size * 8 <= POPULATE_UP_TO_BYTES:
         buf = np.zeros(size)
     else:
         block = mmap.mmap(-1, size * 8, flags=mmap.MAP_PRIVATE | mmap.MAP_ANONYMOUS | populate)

@@ -305,3 +305,33 @@ def test_thirty_blades_2d_boundaries_meet_at_their_corners():
     a = agreement(curves, mp, tuple(info["cell"]))
     assert a["regions"] >= 2 and a["contradicting_cells"] < 20, a
     assert a["contradicting_beyond_one_cell"] - a["contradicting_beyond_one_cell_off_branch"] == 0, a
+
+
+@pytest.mark.slow  # the imported fan blade (158 dofs): a 6 x 8 corner of its quick 3D map and its curves, twice:
+# 22 s on two shared cores, up to 5 min when they are loaded (measured); the whole example's map and curves take 12 min
+def test_boundaries_the_lattice_misses_are_seeded_from_the_maps_verdicts():
+    """The imported fan blade (examples/fan_blade), 3D: by the left edge of the quick map, below g0 = 0.1 mm, two
+    modes' Hopf curves (258 and 291 rad/s, Re within 0.05 /s of zero) bound a thin stable sliver; the quick grid's
+    clearances are quadratic (7 um between its lowest rows) and the seed lattice's rows 0.5 mm apart, so no lattice
+    edge crosses the sliver's lower boundary, the curve along its upper one stops at the corner, and the unstable
+    cells connect round its end to the stable ones: one region, every unstable cell 'contradicting' (the whole map:
+    342 of 1440, 201 beyond one cell). Reproduced on the map's corner (its first 6 speeds and 8 clearances) with a
+    lattice whose second row lies above the sliver, as the default's does on the whole range: the map's own verdict
+    changes that no curve passes seed the missing curves."""
+    from pathlib import Path
+
+    from rotorub_model.structure.params import load_parameters
+
+    m = build_model(load_parameters(Path(__file__).parents[2] / "examples" / "fan_blade" / "example.toml"))
+    speeds, g0s = default_grid(m, quick=True)
+    speeds, g0s = speeds[:6], g0s[:8]
+    mp = run_stability_map(m, "3D", speeds, g0s, executor="serial", progress=False)
+    verdicts = np.where(mp.no_solution | off_branch(mp), -1, mp.unstable.astype(int))
+    curves, info = trace_boundaries(Equilibria(m, "3D"), speeds, g0s, lattice=(6, 2))
+    before = agreement(curves, mp, tuple(info["cell"]))
+    assert before["regions"] == 1 and before["contradicting_beyond_one_cell"] > 0, before  # the lattice alone
+    curves, info = trace_boundaries(Equilibria(m, "3D"), speeds, g0s, lattice=(6, 2), verdicts=verdicts)
+    a = agreement(curves, mp, tuple(info["cell"]))
+    assert info["curves_from_map_edges"] >= 1 and info["map_edges_other_solution"] == 0, info
+    assert a["regions"] >= 3, a  # the sliver and the unstable cells either side are separated from the rest
+    assert a["contradicting_cells"] == 0, a  # measured: 24 before (4 beyond one cell), 0 after

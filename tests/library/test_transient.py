@@ -101,11 +101,13 @@ def test_the_study_figure_states_each_runs_verdict(study, ref_model):
     assert np.all([("1/s" in t) for t in titles if t])
 
 
-@pytest.mark.parametrize("n_rec", [0, 3, 2500])
+@pytest.mark.parametrize("n_rec", [0, 3, 2500, 100_000])
 def test_record_arrays_are_zeros_the_kernel_can_write(n_rec):
     """The records' block (mapped with its pages present from POPULATE_FROM_BYTES on): zeros, C-contiguous and
     writable, the two arrays side by side without overlap."""
-    from rotorub_model.analyses.transient import POPULATE_FROM_BYTES, record_arrays
+    import mmap
+
+    from rotorub_model.analyses.transient import POPULATE_FROM_BYTES, POPULATE_UP_TO_BYTES, record_arrays
 
     q, out = record_arrays(n_rec, 38, 68)
     assert q.shape == (n_rec, 38) and out.shape == (n_rec, 68)
@@ -113,8 +115,10 @@ def test_record_arrays_are_zeros_the_kernel_can_write(n_rec):
         assert a.flags.c_contiguous and a.flags.writeable and not a.any()
     q[...] = 1.0
     assert not out.any()
-    if n_rec * 106 * 8 >= POPULATE_FROM_BYTES:
-        assert q.base is not None and out.base is q.base  # one block
+    assert q.base is not None and out.base is q.base  # one block
+    populated = POPULATE_FROM_BYTES <= n_rec * 106 * 8 <= POPULATE_UP_TO_BYTES
+    mapped = isinstance(q.base.base, memoryview) and isinstance(q.base.base.obj, mmap.mmap)
+    assert mapped == (populated and hasattr(mmap, "MAP_POPULATE"))
 
 
 def test_a_limit_cycle_is_not_called_settled(ref_model):

@@ -42,7 +42,9 @@ curve was seeded on (same sign(det dR/dq)).
 Seeds: the verdicts on a 17 x 17 lattice (each speed swept from the largest clearance down, as
 the grid maps are); every lattice edge from a stable end to an unstable one (or to none: no
 balanced solution there) that no traced curve crosses yet starts a curve, traced both ways until
-it leaves the range, closes, or stops.
+it leaves the range, closes, or stops. Where the grid map is known, its own verdict changes that no curve
+passes seed more (:func:`_seed_from_map`: boundaries below the lattice's second row, which no lattice edge
+crosses on a grid spaced quadratically in g0).
 """
 
 from __future__ import annotations
@@ -109,6 +111,9 @@ class BoundaryTracer:
         self._re_slope: float | None = None  # d Re(mu) / d(offset along the normal) at the last Hopf point [1/s/cell]
         self._gap_slope: dict[str, float] = {}  # d(signed gap) / d(offset), each side of the last event
         self._sheet: float | None = None  # orientation of the maps' branch the curve being traced bounds
+        # curves traced already (scaled polylines): a curve seeded from the map stops where it runs onto one
+        # (it would retrace it to its end; the agreement joins the two there)
+        self.known: list[np.ndarray] = []
 
     # ------------------------------------------------------------------ coordinates
     def to_xy(self, speed: float, g0: float) -> np.ndarray:
@@ -614,6 +619,8 @@ class BoundaryTracer:
                     since = len(pts)
                 pts.append((pn, kind, smp, n_new))
                 p, n, tau, ref = pn, n_new, t_new, (ra, rb)
+                if self.known and min(_distance_to_polyline(p, Q) for Q in self.known) < 0.25 * self.h_max:
+                    break  # onto a curve traced already
                 if len(pts) > 20 and direction > 0 and np.linalg.norm(p - p0) < 0.5 * self.h_max:
                     closed = True
                     break
@@ -879,6 +886,90 @@ def _seed_from_lattice(tr: BoundaryTracer, ls: np.ndarray, lg: np.ndarray, curve
             curves.append(cv)
 
 
+def _cut_or_near(polys: list[np.ndarray], a: np.ndarray, b: np.ndarray) -> bool:
+    """Does a polyline cross the segment a-b or pass within a third of its length of it (a map edge a curve
+    already accounts for)?"""
+    d = b - a
+    L2 = float(d @ d)
+    for P in polys:
+        if len(P) >= 2:
+            c, e = P[:-1], P[1:]
+
+            if _cuts_any(a, b, c, e):
+                return True
+        t = np.clip((P - a) @ d / max(L2, 1e-300), 0.0, 1.0)
+        if np.min(np.linalg.norm(P - (a + t[:, None] * d), axis=1)) < 0.33 * math.sqrt(L2):
+            return True
+    return False
+
+
+def _cuts_any(a: np.ndarray, b: np.ndarray, c: np.ndarray, e: np.ndarray) -> bool:
+    """Does the segment a-b cross any of the segments c[k]-e[k]?"""
+    def orient(p, q, r):
+        return (q[..., 0] - p[..., 0]) * (r[..., 1] - p[..., 1]) - (q[..., 1] - p[..., 1]) * (r[..., 0] - p[..., 0])
+
+    return bool(np.any((orient(a, b, c) * orient(a, b, e) <= 0) & (orient(c, e, a) * orient(c, e, b) <= 0)))
+
+
+def _seed_from_map(tr: BoundaryTracer, speeds: np.ndarray, g0s: np.ndarray, verdicts: np.ndarray,
+                   curves: list[Curve]) -> dict:
+    """Seeds where the grid map's own verdicts change between neighbouring cells and no curve passes.
+
+    The lattice sees a boundary only where one of its edges crosses it; on a grid spaced quadratically in g0
+    (the quick maps: 7 um between the two lowest rows, the lattice's rows 0.5 mm apart) a boundary that runs
+    below the lattice's second row is crossed by no lattice edge (the imported fan blade, 3D: a corner of two
+    modes' Hopf curves at g0 < 0.1 mm by the map's left edge; the curve along it stopped at the corner, the
+    unstable cells under the curves connected to the stable ones round its end, and the agreement counted every
+    unstable cell of the map, 342, as contradicting). ``verdicts`` (speeds x g0s): 1 unstable, 0 stable, -1 a
+    cell not to seed from (no solution, or not on the branch the map follows down in g0). The tracer solves
+    each column again as the map does (descending g0, warm-started from the cell above) and traces from an edge
+    whose two ends it finds with the map's verdicts (elsewhere it lands on another equilibrium than the map,
+    which is the agreement's business, not a seed)."""
+    ns, ng = verdicts.shape
+    order = [int(j) for j in np.argsort(g0s)[::-1]]  # the map's sweep: largest clearance first
+    rank = {j: k for k, j in enumerate(order)}
+    columns: dict[int, dict[int, Sample | None]] = {}
+
+    def at(i: int, j: int) -> Sample | None:
+        col = columns.setdefault(i, {})
+        if j not in col:
+            q = None
+            for jj in order[:rank[j] + 1]:  # down from the top (or from the lowest cell solved so far)
+                if jj in col:
+                    q = None if col[jj] is None else col[jj].q
+                    continue
+                smp = tr.sample(tr.to_xy(speeds[i], g0s[jj]), q)
+                col[jj] = smp
+                q = smp.q if smp is not None else None
+        return col[j]
+
+    edges = [((i, order[k]), (i, order[k + 1])) for i in range(ns) for k in range(ng - 1)]
+    edges += [((i, j), (i + 1, j)) for i in range(ns - 1) for j in range(ng)]
+    tried = traced = other = 0
+    for e0, e1 in edges:
+        v0, v1 = verdicts[e0], verdicts[e1]
+        if v0 < 0 or v1 < 0 or v0 == v1:
+            continue
+        a, b = tr.to_xy(speeds[e0[0]], g0s[e0[1]]), tr.to_xy(speeds[e1[0]], g0s[e1[1]])
+        polys = [np.array([tr.to_xy(sp, g) for sp, g in zip(c.speeds, c.g0s)]) for c in curves]
+        if _cut_or_near(polys, a, b):
+            continue
+        s0, s1 = at(*e0), at(*e1)
+        tried += 1
+        if s0 is None or s1 is None or s0.unstable != bool(v0) or s1.unstable != bool(v1):
+            other += 1
+            continue
+        if v0:
+            a, b, s0, s1 = b, a, s1, s0
+        tr.known = [P for P in polys if len(P)]
+        cv = tr.trace(a, b, s0, s1)
+        tr.known = []
+        if cv is not None and len(cv) > 1:
+            curves.append(cv)
+            traced += 1
+    return {"map_edges_tried": tried, "curves_from_map_edges": traced, "map_edges_other_solution": other}
+
+
 def _free_ends(tr: BoundaryTracer, curves: list[Curve]) -> list[np.ndarray]:
     """Ends of curves (scaled coordinates) more than a cell from every other curve and from the map's edge."""
     polys = [np.array([tr.to_xy(sp, g) for sp, g in zip(c.speeds, c.g0s)]) for c in curves]
@@ -896,9 +987,12 @@ def _free_ends(tr: BoundaryTracer, curves: list[Curve]) -> list[np.ndarray]:
 
 
 def trace_boundaries(eq: Equilibria, speeds: np.ndarray, g0s: np.ndarray, resolution: float = 0.1,
-                     lattice: tuple[int, int] = (17, 17)) -> tuple[list[Curve], dict]:
+                     lattice: tuple[int, int] = (17, 17),
+                     verdicts: np.ndarray | None = None) -> tuple[list[Curve], dict]:
     """Every stability-boundary curve inside the range of the map grid (normalised ``speeds`` x
-    ``g0s`` [m]), points at most ``resolution`` cells apart."""
+    ``g0s`` [m]), points at most ``resolution`` cells apart. ``verdicts``: the grid map's (speeds x g0s;
+    1 unstable, 0 stable, -1 not to seed from), where it is known: its verdict changes that no curve
+    passes seed more curves (:func:`_seed_from_map`)."""
     cs = (speeds[-1] - speeds[0]) / max(len(speeds) - 1, 1)
     cg = (g0s.max() - g0s.min()) / max(len(g0s) - 1, 1)
     tr = BoundaryTracer(eq, (float(speeds[0]), float(speeds[-1])), (float(g0s.min()), float(g0s.max())), (cs, cg),
@@ -922,5 +1016,8 @@ def trace_boundaries(eq: Equilibria, speeds: np.ndarray, g0s: np.ndarray, resolu
             _seed_from_lattice(tr, np.unique(local_s), np.unique(local_g)[::-1], curves)
         if len(curves) == n_before:
             break
+    from_map = {}
+    if verdicts is not None:
+        from_map = _seed_from_map(tr, np.asarray(speeds), np.asarray(g0s), np.asarray(verdicts), curves)
     return curves, {"evaluations": tr.evaluations, "cell": [cs, cg], "resolution_cells": resolution,
-                    "lattice": list(lattice), "points_by_corrector": dict(tr.by_corrector)}
+                    "lattice": list(lattice), "points_by_corrector": dict(tr.by_corrector), **from_map}

@@ -473,11 +473,16 @@ def run_continuation(model: Model, maps: dict[str, StabilityMap] | None = None, 
         if boundaries:
             t0 = time.perf_counter()
             with stage(f"continuation {f}: stability boundary as curves over the maps' range", progress):
-                cv, info = trace_boundaries(eq, np.asarray(speeds), np.asarray(g0s))
+                # the map's verdicts (cells on the branch it follows) seed what the lattice misses
+                mp = maps.get(f) if maps else None
+                verdicts = None if mp is None else np.where(mp.no_solution | off_branch(mp), -1,
+                                                            mp.unstable.astype(int))
+                cv, info = trace_boundaries(eq, np.asarray(speeds), np.asarray(g0s), verdicts=verdicts)
             curves[f] = cv
             timings[f"boundary_{f}"] = time.perf_counter() - t0
             agree[f] = {"evaluations": info["evaluations"], "resolution_cells": info["resolution_cells"],
-                        "points_by_corrector": info["points_by_corrector"]}
+                        "points_by_corrector": info["points_by_corrector"],
+                        **{k: v for k, v in info.items() if "map_edges" in k}}
             if maps and f in maps:
                 agree[f].update(agreement(cv, maps[f], tuple(info["cell"])))
     return ContinuationResult(speed, branches, orbits, curves, agree, timings, maps or {}, source)
