@@ -246,3 +246,32 @@ def test_the_trivial_multiplier_is_the_one_along_the_orbit():
     kept = _multipliers(D, along=V[:, 0] * 2.5)
     assert np.abs(kept).max() == pytest.approx(0.999996, abs=1e-9) and np.abs(kept).max() < 1 + MULTIPLIER_TOL
     assert np.abs(_multipliers(D)).max() == pytest.approx(1.0000061, abs=1e-9)  # the nearest-to-1 rule
+
+
+def test_continuation_solves_on_one_blas_thread_and_a_large_problem_keeps_its_threads(monkeypatch, ref_model):
+    """Continuation's many small static solutions and eigenproblems run on one BLAS thread (rotorub_model/threads.py:
+    an 18-blade configuration at load 5.5 took 2 min 57 s with OpenBLAS's thread per core, 44 s on one); a problem of
+    BLAS_THREADS_FROM unknowns or more keeps the caller's threads."""
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    import rotorub_model.analyses.continuation.study as study
+    from rotorub_model.threads import BLAS_THREADS_FROM, blas_threads
+
+    def blas():
+        return {i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"}
+
+    seen = []
+
+    def spy(*args, **kwargs):
+        seen.append(blas())
+        raise RuntimeError("stop here")
+
+    monkeypatch.setattr(study, "_run_continuation", spy)
+    with threadpool_limits(limits=2):  # a user's process: a thread per core (the suite's conftest pins one)
+        with pytest.raises(RuntimeError, match="stop here"):
+            study.run_continuation(ref_model, speeds=np.array([3.0, 3.5]), g0s=np.array([0.0, 1e-3]))
+        with blas_threads(BLAS_THREADS_FROM):
+            seen.append(blas())
+        after = blas()
+    assert seen[0] <= {1}, seen
+    assert seen[1] == after, (seen, after)  # the caller's limit, unchanged

@@ -40,6 +40,7 @@ from ...errors import ParameterError
 from ...plotting import legend_outside, pyplot, save_figure
 from ...structure.model import Model
 from ...structure.params import to_dict
+from ...threads import blas_threads
 from ...writing import write_json
 from ..linear import first_order
 from ..sweeps import run_tasks
@@ -407,7 +408,6 @@ def tip_cap(model: Model, problem: HBProblem, contact) -> callable:
 # changes)
 SPECIAL_LABELS = {"fold": "HB fold", "branch": "HB branch point", "stability": "HB change of stability"}
 
-BLAS_THREADS_FROM = 1500  # unknowns of the balance from which the branch's dense algebra uses every core
 
 
 def follow_segments(problem: HBProblem, start: float, stop: float, g0: float, halt, max_points: int,
@@ -482,7 +482,7 @@ def run_interaction_map(model: Model, formulation: str = "2D", speed_range: tupl
     # small dense algebra: BLAS threads only fight on a shared machine; a large balance (an imported blade's contact
     # spans most of its dofs: 3108 unknowns for the example in 3D) is one dense LU a Newton step, which they share
     # (measured 1.6x on 2 cores), and the transients run only after the branch
-    with threadpool_limits(limits=1 if problem.N < BLAS_THREADS_FROM else None):
+    with blas_threads(problem.N):  # the balance's unknowns: every core only for a large one
         def shown(p) -> None:  # where the branch is: a resonance can take hundreds of orbits of a small range
             bar.set_postfix_str(f"Ω/Ω_ref = {p.omega / wr:.4g} in [{lo:g}, {hi:g}]", refresh=False)
             bar.update(1)
