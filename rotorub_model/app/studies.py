@@ -232,7 +232,7 @@ def _choose_transient_point(model: Model, stab_dir: str | Path | None, maps: dic
     needed = 2.0 * np.log(DIVERGENCE_GROWTH) / pt.max_real_2d * 2.0  # the margin of 2 on the rate
     return TransientPoint(pt.speed, pt.g0, pt.source, pt.max_real_2d, False,
                           f"no qualifying point of this configuration has a 2D instability fast enough for a "
-                          f"{t_end:g} s run: the picker asks for Re lambda >= {2 * visible_rate:.3g} 1/s (twice the "
+                          f"{t_end:g} s run: the picker asks for Re λ >= {2 * visible_rate:.3g} 1/s (twice the "
                           f"rate at which the envelope grows {DIVERGENCE_GROWTH:g}-fold over the second half, a "
                           f"margin for the ringing and the contact changes on the way), here {pt.max_real_2d:.3g} "
                           f"1/s; the run may or may not show it: --t-end {np.ceil(needed):.0f} s or longer meets "

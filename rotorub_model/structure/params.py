@@ -435,11 +435,6 @@ def _check_consistency(p: Parameters) -> None:
     if p.contact.g0 <= -0.5 * b.length:
         raise ParameterError(f"contact.g0: {p.contact.g0:g} m out of range; accepted range (-blades.length/2, "
                              f"{INPUT_RANGES['g0_max'][1]:g}] m")
-    if p.contact.g0 > INPUT_RANGES["g0_max"][1]:
-        # what the CLI and the FMUs accept: a file's g0 beyond it (0.5 written for 0.5 mm) was taken as metres and
-        # only refused later, by rotorub static, under the name of a flag the user never gave (--g0)
-        raise ParameterError(f"contact.g0: {p.contact.g0:g} m out of range; accepted range (-blades.length/2, "
-                             f"{INPUT_RANGES['g0_max'][1]:g}] m (metres: 0.5 mm is 0.5e-3)")
     if p.casing.ring_thickness >= casing_inner:
         raise ParameterError("casing.ring_thickness: must be smaller than the casing inner radius")
     half_chord_axial = 0.5 * p.contact.chord
@@ -517,9 +512,16 @@ def load_parameters(path: str | Path | None = None) -> Parameters:
             f = Path(fe[key]).expanduser()
             fe[key] = str(f if f.is_absolute() else (Path(path).resolve().parent / f))
     try:
-        return from_dict(data)
+        p = from_dict(data)
     except ParameterError as exc:
         raise ParameterError(f"{where}: {exc}") from None
+    if p.contact.g0 > INPUT_RANGES["g0_max"][1]:
+        # what the CLI and the FMUs accept: a file's g0 beyond it (0.5 written for 0.5 mm) was taken as metres and
+        # only refused later, by rotorub static, under the name of a flag the user never gave (--g0). A file only:
+        # the library itself may place a casing far away (make_contact(model, f, g0=1.0): a rotor that never touches)
+        raise ParameterError(f"{where}: contact.g0: {p.contact.g0:g} m out of range; accepted range "
+                             f"(-blades.length/2, {INPUT_RANGES['g0_max'][1]:g}] m (metres: 0.5 mm is 0.5e-3)")
+    return p
 
 
 _REFERENCE: Parameters | None = None

@@ -476,8 +476,10 @@ def _run_continuation(model: Model, maps: dict[str, StabilityMap] | None = None,
         timings[f"branch_{f}"] = time.perf_counter() - t0
         if progress:
             n_contact = len(b.of_kind("contact"))  # as the summary counts them: contact events apart
-            say(f"continuation {f}: branch {len(b.points)} points, {len(b.specials) - n_contact} special points "
-                f"and {n_contact} contact events ({timings[f'branch_{f}']:.1f} s)")
+            n_special = len(b.specials) - n_contact
+            say(f"continuation {f}: branch {len(b.points)} points, {n_special} special point"
+                f"{'' if n_special == 1 else 's'} and {n_contact} contact event{'' if n_contact == 1 else 's'} "
+                f"({timings[f'branch_{f}']:.1f} s)")
         t0 = time.perf_counter()
         with stage(f"continuation {f}: periodic orbits past the loss of stability (at most {max_orbits})", progress):
             orbits[f] = _orbits(eq, b, omega, max_orbits) if b.points else []
