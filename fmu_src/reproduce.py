@@ -167,7 +167,7 @@ def verdict_lines(s: dict) -> list[str]:
     tr = s["harnesses"]["transient"]
     lines.append("  section 6 through the FMU: " + "; ".join(
         f"{f} diverged: {_fmt(tr[f].get('diverged'))} (penetration limit {_fmt(tr[f].get('penetration_limit_hit'))}, "
-        f"envelope growing {_fmt(tr[f].get('envelope_growing'))})" for f in ("2D", "3D")))
+        f"envelope growing {_fmt(tr[f].get('envelope_growing'))}){_swing(tr[f])}" for f in ("2D", "3D")))
     c = s.get("coupled_run")
     if c:
         lines.append(f"  engine (spool + contact FMUs): the rub costs the spool up to "
@@ -214,6 +214,13 @@ def _largest(d: dict | None) -> float | None:
     return None if not d else max(d.values())
 
 
+def _swing(t: dict) -> str:
+    """', not settled: F_N still swings a-b N' for a run whose force still oscillates at its end (a limit cycle: its
+    envelope is flat, so 'diverged: no' alone read like a run at rest)."""
+    sw = t.get("force_swing_last_s_N")
+    return f", not settled: F_N still swings {sw[0]:.3g}-{sw[1]:.3g} N" if sw else ""
+
+
 def _transient_note(t: dict) -> str:
     """The two meanings of a diverging run apart (as in every JSON): the penetration limit and the growing envelope."""
     g = t.get("envelope_growth") or {}
@@ -221,7 +228,7 @@ def _transient_note(t: dict) -> str:
     if g.get("factor") is not None:
         grow += f" (×{g['factor']:.3g}, {g['rate_per_s']:+.3g} 1/s)"
     return (f"diverged: {_fmt(t.get('diverged'))} (penetration limit hit: {_fmt(t.get('penetration_limit_hit'))}, "
-            f"force envelope growing: {grow}), blades at 1 s: {t['blades_in_contact_at_1s']}")
+            f"force envelope growing: {grow}){_swing(t)}, blades at 1 s: {t['blades_in_contact_at_1s']}")
 
 
 def report_section(s: dict) -> str:

@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rotorub_model.analyses.transient import SWING_WINDOW_S
 from rotorub_model.plotting import pyplot, save_figure
 from rotorub_model.writing import write_json
 
@@ -309,9 +310,13 @@ def _verdict(s: dict) -> str:
         return "diverged: the penetration limit was hit"
     if g.get("factor") is None:
         return "no growth verdict (a run shorter than 4 s)"
-    return (("diverged: " if s.get("envelope_growing") else "not diverging: ")
-            + f"force envelope ×{g['factor']:.3g} over {g['window_s'][0]:.3g}-{g['window_s'][1]:.3g} s "
+    what = (f"force envelope ×{g['factor']:.3g} over {g['window_s'][0]:.3g}-{g['window_s'][1]:.3g} s "
             f"({g['rate_per_s']:+.3g} 1/s)")
+    if s.get("envelope_growing"):
+        return "diverged: " + what
+    swing = s.get("force_swing_last_s_N")  # a flat envelope is not a settled rub (as the library's verdict says)
+    return "not diverging: " + what + (f"; not settled: F_N still swings {swing[0]:.3g}-{swing[1]:.3g} N over the "
+                                       f"last {SWING_WINDOW_S:g} s" if swing else "")
 
 
 def _plot_forces(runs: dict[str, FMURun], path: Path, title: str, verdicts: dict[str, str]) -> Path:
@@ -334,7 +339,7 @@ def _plot_forces(runs: dict[str, FMURun], path: Path, title: str, verdicts: dict
 def transient_pair(fmu: str | Path, model, speed: float, g0: float, out: str | Path, t_end: float = 20.0,
                    t_ramp: float = 1.0, h: float = H_TRANSIENT, progress: bool = False) -> dict:
     """Section 6 through the FMU: 2D and 3D at (speed, g0), imbalance ramped over t_ramp by the master."""
-    from rotorub_model.analyses.transient import envelope_grows, run_transient
+    from rotorub_model.analyses.transient import envelope_grows, force_swing, run_transient
     from rotorub_model.contact import make_contact
 
     out = Path(out)
@@ -367,6 +372,8 @@ def transient_pair(fmu: str | Path, model, speed: float, g0: float, out: str | P
             "t_reached_s": float(r.t[-1]) if len(r.t) else 0.0,
             "blades_in_contact_at_1s": int((r.F_N[i1] > 0).sum()) if len(r.t) else 0,
             "max_normal_force_N": float(r.F_N.max()) if r.F_N.size else 0.0,
+            # [lowest, highest] F_N [N] of the blade swinging most over the last 2 s where it still swings
+            "force_swing_last_s_N": list(sw) if len(r.t) and (sw := force_swing(r.t, r.F_N)) else None,
             "final_chord_fractions": r.fraction[-1].round(4).tolist() if len(r.t) else [],
             "seconds_fmu": r.seconds,
             "library_penetration_limit_hit": bool(lib.penetration_limit_hit),

@@ -511,6 +511,19 @@ SWING_WINDOW_S = 2.0
 SWING_MIN_REL = 0.05
 
 
+def force_swing(t: np.ndarray, F_N: np.ndarray | None) -> tuple[float, float] | None:
+    """(lowest, highest) normal force [N] of the blade whose force swings most over a run's last SWING_WINDOW_S,
+    where that swing exceeds SWING_MIN_REL of its highest value (the run still oscillates: a limit cycle or ringing
+    not yet gone); None where the forces have settled, or the run is too short. ``F_N``: (records, blades), at the
+    times ``t`` (the library's runs and the FMU harnesses' alike)."""
+    if F_N is None or F_N.size == 0 or t[-1] - t[0] < 2 * SWING_WINDOW_S:
+        return None
+    last = F_N[t >= t[-1] - SWING_WINDOW_S]
+    j = int(np.argmax(np.ptp(last, axis=0)))
+    lo, hi = float(last[:, j].min()), float(last[:, j].max())
+    return (lo, hi) if hi > 0.0 and hi - lo > SWING_MIN_REL * hi else None
+
+
 @dataclass
 class TransientResult:
     formulation: str
@@ -565,15 +578,8 @@ class TransientResult:
 
     def force_swing(self) -> tuple[float, float] | None:
         """(lowest, highest) normal force [N] of the blade whose force swings most over the run's last
-        SWING_WINDOW_S, where that swing exceeds SWING_MIN_REL of its highest value (the run still oscillates:
-        a limit cycle or ringing not yet gone); None where the forces have settled, or the run is too short."""
-        F = self.outputs.get("F_N")
-        if F is None or F.size == 0 or self.t[-1] - self.t[0] < 2 * SWING_WINDOW_S:
-            return None
-        last = F[self.t >= self.t[-1] - SWING_WINDOW_S]
-        j = int(np.argmax(np.ptp(last, axis=0)))
-        lo, hi = float(last[:, j].min()), float(last[:, j].max())
-        return (lo, hi) if hi > 0.0 and hi - lo > SWING_MIN_REL * hi else None
+        SWING_WINDOW_S (:func:`force_swing`)."""
+        return force_swing(self.t, self.outputs.get("F_N"))
 
     def summary(self) -> dict:
         o = self.outputs

@@ -50,3 +50,24 @@ def test_the_librarys_report_knows_no_fmu_key():
     text = (ROOT / "rotorub_model" / "app" / "report.py").read_text()
     assert [k for k in FMU_KEYS if re.search(rf"['\"]{k}", text)] == []
     assert "sections" in text
+
+
+def test_a_limit_cycle_through_the_fmu_reads_not_settled():
+    """A run through the FMU whose envelope is flat but whose force still swings (a limit cycle: a user's 8-blade
+    configuration swung a blade 90-181 N) says so in the report's table and in the harness's verdict, as the
+    library's transient verdict does, instead of a bare 'diverged: no' that reads like a run at rest."""
+    from fmu_src.masters.analyses import _verdict
+    from fmu_src.reproduce import verdict_lines
+
+    s = {**_summary(), "fmu": {"platforms": ["linux64"]}}
+    s["harnesses"]["transient"]["2D"]["force_swing_last_s_N"] = [90.3, 181.0]
+    md = report_section(s)
+    assert "force envelope growing: no), not settled: F_N still swings 90.3-181 N, blades at 1 s: 10" in md
+    line = next(x for x in verdict_lines(s) if "section 6 through the FMU" in x)
+    assert "2D diverged: no (penetration limit no, envelope growing no), not settled: F_N still swings 90.3-181 N" \
+        in line
+    assert "not settled" not in line.split(";")[1]  # the 3D run has no swing
+    flat = {"envelope_growing": False, "force_swing_last_s_N": [90.3, 181.0],
+            "envelope_growth": {"factor": 1.02, "rate_per_s": 0.001, "window_s": [10.0, 20.0]}}
+    assert _verdict(flat).endswith("not settled: F_N still swings 90.3-181 N over the last 2 s")
+    assert "not settled" not in _verdict({**flat, "force_swing_last_s_N": None})
