@@ -288,7 +288,8 @@ class CentralDifference:
                 rec_out: np.ndarray | None = None) -> tuple[int, int]:
         """Advance n_steps at constant inputs in one kernel call; returns (steps done, records written).
 
-        Records: every ``rec_every``-th step of the run, q into ``rec_q`` and (if given) the
+        Records: every ``rec_every``-th step of the run (``rec_every < 0``: the call's last step only), q into
+        ``rec_q`` and (if given) the
         outputs of the state (rotating frame, kernel layout) into ``rec_out``, from row
         ``rec_start``.
         """
@@ -739,8 +740,6 @@ def run_transient(
     rec_q, rec_out = record_arrays(n_rec, model.n_dofs, contact.n_outputs)
     constant = not callable(omega)
     seg_steps = n_total if constant else max(1, int(round(segment / dt_)))
-    if hold is not None:
-        seg_steps = max(1, int(round(hold / dt_)))
     if liner is not None:  # the kernel copies the profile every wear_every steps as it goes
         wear_every = max(1, int(round(wear_record_dt / dt_)))
         wear_rows = np.zeros((n_total // wear_every, liner.n_sectors))
@@ -755,25 +754,28 @@ def run_transient(
     steps_used = {integ.dt}
     if hold is not None:  # one held interval at a time, recorded at its end, as a master reads the FMU
         n_held, rec_held = int(round(t_end / hold)), max(1, int(round(record_dt / hold)))
+        plans: dict[int, float] = {}
         if bar is not None:
             bar.total = n_total  # in the first interval's steps: the plan may change them
         for k in range(n_held):
             t_a = integ.t
             w_k = omega_fn(t_a)
             me_k = me * (1.0 if (t_ramp <= 0 or t_a >= t_ramp) else t_a / t_ramp)
-            if plan is not None and plan(w_k) != integ.dt:
-                integ.restart(plan(w_k), w_k)  # at the same velocity, as the FMU
-                steps_used.add(integ.dt)
+            if plan is not None:
+                band = math.ceil(w_k)  # the FMU's limit is per whole rad/s: so is its plan
+                dt_k = plans.get(band)
+                if dt_k is None:
+                    dt_k = plans[band] = plan(w_k)
+                if dt_k != integ.dt:
+                    integ.restart(dt_k, w_k)  # at the same velocity, as the FMU
+                    steps_used.add(integ.dt)
             n = max(1, int(round(hold / integ.dt)))
-            if (k + 1) % rec_held == 0 and written < n_rec:
-                done = integ.advance(n - 1, w_k, me_k)[0] if n > 1 else 0
-                if not integ.diverged and done == n - 1:
-                    before = written
-                    last, written = integ.advance(1, w_k, me_k, rec_every=1, rec_q=rec_q, rec_start=written,
-                                                  rec_out=rec_out)
-                    done += last
-                    if written > before:
-                        phi_rec.append(integ.phi)
+            if (k + 1) % rec_held == 0 and written < n_rec:  # the interval's last step recorded (rec_every < 0)
+                before = written
+                done, written = integ.advance(n, w_k, me_k, rec_every=-1, rec_q=rec_q, rec_start=written,
+                                              rec_out=rec_out)
+                if written > before:
+                    phi_rec.append(integ.phi)
             else:
                 done = integ.advance(n, w_k, me_k)[0]
             done_total += done
@@ -784,18 +786,10 @@ def run_transient(
     while hold is None and done_total < n_total:
         n = min(seg_steps, n_total - done_total)
         t_a, t_b = integ.t, integ.t + n * dt_
-        if hold is not None:
-            w_mid, w_dot = omega_fn(t_a), 0.0
-            me_k = me * (1.0 if (t_ramp <= 0 or t_a >= t_ramp) else t_a / t_ramp)
-        else:
-            w_mid = omega_fn(0.5 * (t_a + t_b))
-            w_dot = 0.0 if constant else (omega_fn(t_b) - omega_fn(t_a)) / (t_b - t_a)
-            me_k = me
-        before = written
-        done, written = integ.advance(n, w_mid, me_k, w_dot, rec_every=rec_every, rec_q=rec_q, rec_start=written,
+        w_mid = omega_fn(0.5 * (t_a + t_b))
+        w_dot = 0.0 if constant else (omega_fn(t_b) - omega_fn(t_a)) / (t_b - t_a)
+        done, written = integ.advance(n, w_mid, me, w_dot, rec_every=rec_every, rec_q=rec_q, rec_start=written,
                                       rec_out=rec_out)
-        if hold is not None and written > before:
-            phi_rec.append(integ.phi)
         done_total += done
         if bar is not None:
             bar.update(done)

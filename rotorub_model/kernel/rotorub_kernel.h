@@ -309,7 +309,8 @@ typedef struct {
     double omega;         /* spin speed [rad/s]: advances the frame angle */
     double me;            /* imbalance m e [kg m] */
     double t_ramp;        /* imbalance ramp r(t) = min(t / t_ramp, 1); <= 0: r = 1 */
-    int rec_every;        /* record every rec_every-th step of the run (counted by state->steps) */
+    int rec_every;        /* record every rec_every-th step of the run (counted by state->steps); < 0: the call's
+                           * last step only (a master's communication point, whatever the steps before) */
     int rec_cap;          /* rows of rec_q / rec_out (0: no records) */
     int n_rec;            /* in: first free row; out: rows written */
     double *rec_q;        /* (rec_cap, n) the recorded q */

@@ -206,6 +206,7 @@ int rr_cd_run(rr_cd_job *job)
     const rr_cd_matrices *m = job->mats;
     int i, k, n = c->n, nb = c->nb, rows = nb * c->np;
     int done = 0, written = job->n_rec, rec_every = job->rec_every < 1 ? 1 : job->rec_every;
+    const int rec_last = job->rec_every < 0; /* the call's last step only */
     double *gaps, *law, *fr, *rhs = c->work + 2 * rows + nb * RR_LAW_WIDTH;
     double *q = s->q, *qp = s->q_prev;
     const double t0 = s->t, dt = s->dt, floor_gap = -s->max_pen, t_ramp = job->t_ramp, me = job->me;
@@ -275,7 +276,7 @@ int rr_cd_run(rr_cd_job *job)
             }
             ++job->n_rec_wear;
         }
-        if (written < rec_cap && (step0 + i + 1) % rec_every == 0) {
+        if (written < rec_cap && (rec_last ? i + 1 == job->n_steps : (step0 + i + 1) % rec_every == 0)) {
             for (k = 0; k < n; ++k) rec_q[(size_t)written * n + k] = q[k];
             if (rec_out)
                 rri_outputs_from_law(c, q, gaps, law, fr, 0.0, NULL,
