@@ -162,8 +162,9 @@ def run_manoeuvre_scenario(out_dir: str | Path, quick: bool = True, fmu_dir: str
     out.mkdir(parents=True, exist_ok=True)
     cfg = scenario_settings(quick)
     t0 = time.perf_counter()
+    built_here = not fmus
     fmus = fmus or build_manoeuvre_fmus(Path(fmu_dir) if fmu_dir else out / "fmus", omega0=cfg["speed"])
-    build_s = time.perf_counter() - t0
+    build_s = time.perf_counter() - t0 if built_here else None  # None ("–"): the FMUs were given
     ssp = write_manoeuvre_ssp(out / "RotorRubEngineManoeuvre.ssp", fmus, cfg)
     level = write_manoeuvre_ssp(out / "RotorRubEngineManoeuvre_level_flight.ssp", fmus, cfg, LEVEL_FLIGHT,
                                 name="RotorRubEngineLevelFlight")

@@ -70,9 +70,10 @@ def run_wear_scenario(out_dir: str | Path, quick: bool = True, fmu_dir: str | Pa
     out.mkdir(parents=True, exist_ok=True)
     cfg = scenario_settings(quick)
     t0 = time.perf_counter()
+    built_here = not fmus
     fmus = fmus or build_wear_fmus(Path(fmu_dir) if fmu_dir else out / "fmus", platforms=platforms,
                                    omega0=cfg["spool_params"]["Omega0"])
-    build_s = time.perf_counter() - t0
+    build_s = time.perf_counter() - t0 if built_here else None  # None ("–"): the FMUs were given
     common = {"g0": G0_RUB, "imbalance": imbalance, "formulation": cfg["formulation"],
               "spool_params": cfg["spool_params"], "t_end": cfg["t_end"], "h": cfg["h"]}
     ssp = write_ssp(out / "RotorRubEngineWear.ssp", fmus["contact"], fmus["spool"], clearance_fmu=fmus["clearance"],
