@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rotorub_model.analyses.transient import SWING_WINDOW_S
+from rotorub_model.analyses.transient import not_settled_words
 from rotorub_model.plotting import pyplot, save_figure
 from rotorub_model.writing import write_json
 
@@ -315,8 +315,7 @@ def _verdict(s: dict) -> str:
     if s.get("envelope_growing"):
         return "diverged: " + what
     swing = s.get("force_swing_last_s_N")  # a flat envelope is not a settled rub (as the library's verdict says)
-    return "not diverging: " + what + (f"; not settled: F_N still swings {swing[0]:.3g}-{swing[1]:.3g} N over the "
-                                       f"last {SWING_WINDOW_S:g} s" if swing else "")
+    return "not diverging: " + what + not_settled_words(swing)
 
 
 def _plot_forces(runs: dict[str, FMURun], path: Path, title: str, verdicts: dict[str, str]) -> Path:

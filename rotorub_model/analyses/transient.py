@@ -525,6 +525,13 @@ def force_swing(t: np.ndarray, F_N: np.ndarray | None) -> tuple[float, float] | 
     return (lo, hi) if hi > 0.0 and hi - lo > SWING_MIN_REL * hi else None
 
 
+def not_settled_words(swing: tuple[float, float] | None) -> str:
+    """'; not settled: F_N still swings a-b N over the last 2 s' after a verdict, for a :func:`force_swing`; ''
+    for None (the library's verdict and the FMU harnesses' say it alike)."""
+    return (f"; not settled: F_N still swings {swing[0]:.3g}-{swing[1]:.3g} N over the last {SWING_WINDOW_S:g} s"
+            if swing else "")
+
+
 @dataclass
 class TransientResult:
     formulation: str
@@ -574,8 +581,7 @@ class TransientResult:
         swing = self.force_swing()
         # a flat envelope is not a settled rub: a limit cycle that swings a blade's force 90-181 N for ever read
         # "not diverging" like a run at rest on its static solution
-        return "not diverging: " + what + (f"; not settled: F_N still swings {swing[0]:.3g}-{swing[1]:.3g} N over "
-                                           f"the last {SWING_WINDOW_S:g} s" if swing else "")
+        return "not diverging: " + what + not_settled_words(swing)
 
     def force_swing(self) -> tuple[float, float] | None:
         """(lowest, highest) normal force [N] of the blade whose force swings most over the run's last

@@ -155,10 +155,11 @@ def choose_transient_point(model: Model, stab_dir: str | Path | None = None, map
     """:func:`_choose_transient_point` on one BLAS thread: its hundreds of static solutions and eigenvalue problems
     are small (38-160 dofs) and gain nothing from threads, while OpenBLAS's thread per core, spinning against other
     work on a loaded machine, made it 8x slower (an 18-blade configuration, load 5 on 2 cores: 44.6 s against 5.5 s
-    on one thread). A sweep's workers limit their own (analyses/sweeps.py)."""
-    from threadpoolctl import threadpool_limits
+    on one thread). The rule is rotorub_model/threads.py's (2 n unknowns); a sweep's workers limit their own
+    (analyses/sweeps.py)."""
+    from ..threads import blas_threads
 
-    with threadpool_limits(limits=1):
+    with blas_threads(2 * model.n_dofs):
         return _choose_transient_point(model, stab_dir, maps, progress, t_end)
 
 

@@ -230,8 +230,7 @@ int rr_cd_run(rr_cd_job *job)
         /* the engine's inputs changed since the last cut (or none yet): the return map sees the new surface
          * before the first force, so a jump while cutting keeps the force at the yield bound (the liner's law
          * is then exact whatever the inputs do between calls, not only for slow changes) */
-        rri_surface_recut(c, q, gaps);
-        job->cache_valid = 0;
+        rri_surface_recut(c, q, gaps); /* (a surface that wears: no evaluation kept, see `cached`) */
     }
     if (!(cached && cache_holds(job, c, omega, dt))) {
         rri_gaps_of(c, q, gaps);

@@ -246,6 +246,22 @@ static double segment_on_casing(const rr_contact *c, int j, const double *L, con
 /* the lesser tip gap, a NaN propagating as numpy's min does */
 static double gap_min(double a, double b) { return (a <= b || a != a) ? a : b; }
 
+#define RR_PUT(pos, value) (index ? (dest[index[(pos)]] = (value)) : (dest[(pos)] = (value)))
+
+/* reported blade b's outputs (into dest, through index when given), and what the globals gather from it */
+static void put_blade(double *dest, const int *index, int nbo, int b, double FN, double FT, double gle, double gte,
+                      double gtip, double frac, int *n_contact, double *gmin)
+{
+    RR_PUT(RR_OUT_FN * nbo + b, FN);
+    RR_PUT(RR_OUT_FT * nbo + b, FT);
+    RR_PUT(RR_OUT_GAP_LE * nbo + b, gle);
+    RR_PUT(RR_OUT_GAP_TE * nbo + b, gte);
+    RR_PUT(RR_OUT_GAP_TIP * nbo + b, gtip);
+    RR_PUT(RR_OUT_FRACTION * nbo + b, frac);
+    if (FN > 0.0) ++*n_contact;
+    if (gtip < *gmin || gtip != gtip) *gmin = gtip;
+}
+
 void rri_outputs_from_law(const rr_contact *c, const double *q, const double *gaps, const double *law,
                           const double *fr, double phi, const int *index, double *dest)
 {
@@ -253,20 +269,12 @@ void rri_outputs_from_law(const rr_contact *c, const double *q, const double *ga
     double Fc[3] = {0.0, 0.0, 0.0}, torque = 0.0;
     double dx = 0.0, dy = 0.0, gmin = HUGE_VAL, cs, sn, vals[RR_OUT_GLOBALS];
     int n_contact = 0;
-#define RR_PUT(pos, value) (index ? (dest[index[(pos)]] = (value)) : (dest[(pos)] = (value)))
     if (!c->blade_of) { /* built-in blades: each kernel blade is a reported blade (the outputs' every step) */
         for (j = 0; j < nb; ++j) {
             const double *L = law + RR_LAW_WIDTH * j;
             double gle = gaps[np * j], gte = gaps[np * j + np - 1], gtip = gap_min(gle, gte);
             double FT = segment_on_casing(c, j, L, fr, Fc, &torque);
-            RR_PUT(RR_OUT_FN * nbo + j, L[0]);
-            RR_PUT(RR_OUT_FT * nbo + j, FT);
-            RR_PUT(RR_OUT_GAP_LE * nbo + j, gle);
-            RR_PUT(RR_OUT_GAP_TE * nbo + j, gte);
-            RR_PUT(RR_OUT_GAP_TIP * nbo + j, gtip);
-            RR_PUT(RR_OUT_FRACTION * nbo + j, L[6]);
-            if (L[0] > 0.0) ++n_contact;
-            if (gtip < gmin || gtip != gtip) gmin = gtip;
+            put_blade(dest, index, nbo, j, L[0], FT, gle, gte, gtip, L[6], &n_contact, &gmin);
         }
     } else { /* an imported tip: a reported blade gathers its segments, leading edge first */
         double FN = 0.0, FT = 0.0, gle = 0.0, gte = 0.0, gtip = HUGE_VAL, frac = 0.0, len = 0.0;
@@ -293,14 +301,7 @@ void rri_outputs_from_law(const rr_contact *c, const double *q, const double *ga
             gte = ste;
             first = last;
             if (!last) continue;
-            RR_PUT(RR_OUT_FN * nbo + b, FN);
-            RR_PUT(RR_OUT_FT * nbo + b, FT);
-            RR_PUT(RR_OUT_GAP_LE * nbo + b, gle);
-            RR_PUT(RR_OUT_GAP_TE * nbo + b, gte);
-            RR_PUT(RR_OUT_GAP_TIP * nbo + b, gtip);
-            RR_PUT(RR_OUT_FRACTION * nbo + b, frac / len);
-            if (FN > 0.0) ++n_contact;
-            if (gtip < gmin || gtip != gtip) gmin = gtip;
+            put_blade(dest, index, nbo, b, FN, FT, gle, gte, gtip, frac / len, &n_contact, &gmin);
         }
     }
     for (k = 0; k < n; ++k) {
