@@ -218,7 +218,8 @@ def _swing(t: dict) -> str:
     """', not settled: F_N still swings a-b N' for a run whose force still oscillates at its end (a limit cycle: its
     envelope is flat, so 'diverged: no' alone read like a run at rest)."""
     sw = t.get("force_swing_last_s_N")
-    return f", not settled: F_N still swings {sw[0]:.3g}-{sw[1]:.3g} N" if sw else ""
+    # only for a run not called diverged, as the library's verdict: a growing run swings, and says so already
+    return f", not settled: F_N still swings {sw[0]:.3g}-{sw[1]:.3g} N" if sw and not t.get("diverged") else ""
 
 
 def _transient_note(t: dict) -> str:

@@ -71,3 +71,6 @@ def test_a_limit_cycle_through_the_fmu_reads_not_settled():
             "envelope_growth": {"factor": 1.02, "rate_per_s": 0.001, "window_s": [10.0, 20.0]}}
     assert _verdict(flat).endswith("not settled: F_N still swings 90.3-181 N over the last 2 s")
     assert "not settled" not in _verdict({**flat, "force_swing_last_s_N": None})
+    # a diverged run swings too: the verdict says diverged and no more, as the library's
+    s["harnesses"]["transient"]["3D"]["force_swing_last_s_N"] = [10.0, 500.0]
+    assert "not settled" not in next(x for x in verdict_lines(s) if "section 6 through the FMU" in x).split(";")[1]
