@@ -65,6 +65,12 @@ def model_description(model: ModelInfo, variables: list[Var], *, fmi: str, token
     tags = {"fmi3" if three else "fmi2", flavour}
     own = declared(variables, tags)
     vars_ = own if three else scalars(own)
+    if three:
+        # structural parameters first: fmusim 0.0.39 (the reference importer) resolves an array's <Dimension
+        # valueReference> while it reads, and crashed on a dimension declared after the arrays using it. FMI 3.0
+        # does not forbid the order; every Reference-FMU declares them first. Value references do not change.
+        vars_ = ([v for v in vars_ if v.causality == "structuralParameter"]
+                 + [v for v in vars_ if v.causality != "structuralParameter"])
     if three and [v.causality for v in own].count("independent") != 1:
         raise ValueError(f"{model.identifier}: an FMI 3.0 description declares exactly one independent variable "
                          "(fmu_src.fmi.variables.TIME in the model's list)")
@@ -223,17 +229,22 @@ def _structure2(root: Element, model: ModelInfo, vars_: list[Var], feedthrough: 
 def _structure3(root: Element, model: ModelInfo, vars_: list[Var], feedthrough: bool) -> None:
     ms = SubElement(root, "ModelStructure")
     deps = [str(v.vr) for v in _inputs(vars_, feedthrough)]
+    if not deps:
+        # an output that depends on no input says so with the independent variable, not with dependencies="":
+        # legal, but OMSimulator's FMI 3.0 reader (fmi4c) crashes on the empty attribute; and leaving the attribute
+        # out would mean "depends on every input" (a false algebraic loop). At a communication point the outputs
+        # follow the state, i.e. time: true, and no input.
+        deps = [str(v.vr) for v in vars_ if v.causality == "independent"]
     for v in vars_:
         if v.causality == "output":
-            attrs = {"valueReference": str(v.vr), "dependencies": " ".join(deps)}
-            if feedthrough:
-                attrs["dependenciesKind"] = " ".join("dependent" for _ in deps)
+            attrs = {"valueReference": str(v.vr), "dependencies": " ".join(deps),
+                     "dependenciesKind": " ".join("dependent" for _ in deps)}
             SubElement(ms, "Output", attrs)
     params = " ".join(str(v.vr) for v in vars_ if v.causality == "parameter")
     for v in vars_:
         if v.causality == "output":
             attrs = {"valueReference": str(v.vr)}
-            if model.initial_from_parameters:
+            if model.initial_from_parameters and params:
                 attrs["dependencies"] = params
             SubElement(ms, "InitialUnknown", attrs)
     for v in vars_:
