@@ -82,3 +82,56 @@ BUILD_FMU = ("build-fmu", "package the contact model as an FMI 2.0 co-simulation
              "(pythonfmu) or, with --native, fmus/native/RotorCasingContact.fmu (C, no Python on the host); with "
              "--native --fmi3, the FMI 3.0 one in fmus/native-fmi3/",
              _add_build_args, _run_build)
+
+
+def _add_check_args(sp: argparse.ArgumentParser) -> None:
+    from .masters.replay import HOSTS
+
+    sp.add_argument("fmu", help="an FMU carrying reference experiments (FMI-LS-REF: every FMU rotorub builds)")
+    sp.add_argument("--host", default="fmpy", choices=HOSTS, help="the importer to replay them in (default fmpy)")
+    sp.add_argument("--only", nargs="+", default=None, metavar="NAME", help="only these experiments")
+    sp.add_argument("--swap-inputs", nargs=2, default=None, metavar=("A", "B"),
+                    help="hand the host inputs A and B the wrong way round (a mis-wired connection: the experiments "
+                         "must fail)")
+    sp.add_argument("--record", default=None, metavar="DIR",
+                    help="write the compatibility information (the FMI tools page's layout) under DIR: "
+                         "DIR/<FMU>/<importer>/<version>/<platform>/ with what the importer produced and the verdict")
+    sp.set_defaults(out=None)
+
+
+def _run_check(ns: argparse.Namespace) -> dict:
+    from rotorub_model.errors import ParameterError
+
+    from .fmi.lsref import ReferenceError_
+    from .masters import compatibility, replay
+
+    if not Path(ns.fmu).is_file():
+        raise ParameterError(f"fmu-check: FMU '{ns.fmu}' not found (give the path of a .fmu file)")
+    try:
+        outcomes = replay.check(ns.fmu, ns.host, tuple(ns.swap_inputs) if ns.swap_inputs else None, ns.only)
+    except ReferenceError_ as exc:
+        raise ParameterError(f"fmu-check: {exc}") from None
+    version = replay.host_version(ns.host)
+    failed = [o for o in outcomes if o.verdict == "FAILED"]
+    ran = [o for o in outcomes if o.verdict != "not run"]
+    lines = [f"{Path(ns.fmu).name} in {ns.host} {version}"
+             + (f" (inputs {ns.swap_inputs[0]} and {ns.swap_inputs[1]} swapped)" if ns.swap_inputs else "") + ":"]
+    lines += ["  " + o.line() for o in outcomes]
+    summary = {"fmu": str(ns.fmu), "host": ns.host, "host_version": version,
+               "swapped_inputs": ns.swap_inputs, "experiments": [o.__dict__ for o in outcomes]}
+    if ns.record and not ns.swap_inputs:
+        summary["recorded"] = str(compatibility.record(ns.fmu, ns.host, version, outcomes, ns.record))
+    lines.append(("FAILED: " + ", ".join(o.experiment for o in failed) + f" ({len(failed)} of {len(ran)} run)")
+                 if failed else f"All {len(ran)} experiments run passed" + (
+                     f" ({len(outcomes) - len(ran)} not run: the importer cannot)" if len(ran) < len(outcomes)
+                     else "") + ".")
+    if summary.get("recorded"):
+        lines.append(f"compatibility information written to {summary['recorded']}")
+    summary["verdict"] = lines
+    summary["exit_code"] = 1 if failed or not ran else 0
+    return summary
+
+
+FMU_CHECK = ("fmu-check", "replay an FMU's own reference experiments (FMI-LS-REF, inside every FMU rotorub builds) "
+             "in an importer (fmpy, fmusim, libcosim, ecos) and print one line per experiment; exit 1 if one fails",
+             _add_check_args, _run_check)

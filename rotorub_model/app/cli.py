@@ -604,7 +604,8 @@ def main(argv: list[str] | None = None) -> int:
     done = _done(ns, result)
     sys.stdout.write((dumps(done.summary) if ns.json else "\n".join(done.verdict)) + "\n")
     sys.stdout.flush()
-    return 0
+    # a command whose verdict is a failure (fmu-check: an experiment failed) says so in its exit code too
+    return int(done.summary.get("exit_code", 0)) if isinstance(done.summary, dict) else 0
 
 
 if __name__ == "__main__":

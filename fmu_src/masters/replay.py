@@ -1,0 +1,245 @@
+"""Replaying an FMU's own reference experiments (FMI-LS-REF, fmu_src/fmi/lsref.py) in a chosen importer:
+``rotorub fmu-check FMU [--host fmpy|fmusim|libcosim|ecos]``, one line per experiment.
+
+Each host is an importer nobody here wrote, driven as its users drive it: fmpy's ``simulate_fmu`` (FMI 2.0 and
+3.0), fmusim 0.0.39 (the Modelica Association's reference importer, built from ../shared/hosts: fmusim_host.py),
+OSP libcosim through libcosimpy (FMI 2.0) and ecos through ecospy (FMI 2.0 and 3.0 scalars: ecos_host.py). Every
+host gets the experiment's parameters as start values, its stimuli as inputs held over each step, and records
+the reference's outputs; :func:`fmu_src.fmi.lsref.compare` judges.
+
+What a host cannot do is said, not failed: libcosim and ecos ignore enumerations (an experiment that sets one is
+``not run``, with the reason), ecos reads no FMI 3.0 array (those columns are left out, with the reason).
+``swap``: the host is handed two inputs the wrong way round (a mis-wired connection), to show that the
+experiments see it.
+"""
+
+from __future__ import annotations
+
+import re
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..fmi import lsref
+from ..fmi.description import enumerations, read_description
+
+HOSTS = ("fmpy", "fmusim", "libcosim", "ecos")
+_ELEMENT = re.compile(r"^(.*)\[(\d+)\]$")
+
+
+@dataclass
+class Outcome:
+    """One experiment in one host."""
+
+    experiment: str
+    verdict: str  # "passed", "FAILED", "not run"
+    detail: str
+    diffs: dict[str, float] = field(default_factory=dict)
+    seconds: float = 0.0
+
+    def line(self) -> str:
+        return f"{self.experiment:<14} {self.verdict:<8} {self.detail}"
+
+
+def host_version(host: str) -> str:
+    if host == "fmpy":
+        import fmpy
+
+        return fmpy.__version__
+    if host == "fmusim":
+        from . import fmusim_host
+
+        return fmusim_host.version()
+    if host == "libcosim":
+        from importlib.metadata import version
+
+        return "libcosimpy " + version("libcosimpy")
+    from . import ecos_host
+
+    return ecos_host.version()
+
+
+def host_unavailable(host: str) -> str | None:
+    """None when ``host`` can run here, else why not (one line)."""
+    if host not in HOSTS:
+        return f"host '{host}' unknown; accepted: {', '.join(HOSTS)}"
+    if host == "fmusim":
+        from . import fmusim_host
+
+        return fmusim_host.available()
+    if host == "ecos":
+        from . import ecos_host
+
+        return ecos_host.available()
+    module = {"fmpy": "fmpy", "libcosim": "libcosimpy"}[host]
+    try:
+        __import__(module)
+    except Exception as exc:  # an import that fails for any reason (a missing system library) means: not here
+        return f"{module} cannot be imported ({exc.__class__.__name__}: {exc})"
+    return None
+
+
+def _start_values(fmu: Path, e: lsref.RefExperiment) -> dict[str, float | int]:
+    """The experiment's parameters as the FMU takes them (an enumeration's item name -> its value)."""
+    variables, _units, root = read_description(fmu)
+    enums = enumerations(root)
+    out: dict[str, float | int] = {}
+    for name, v in e.parameters.items():
+        var = variables.get(name)
+        if var is None:
+            raise lsref.ReferenceError_(f"experiment {e.name}: parameter '{name}' is not a variable of {fmu.name}")
+        if isinstance(v, str):
+            items = dict(enums.get(var.declared_type or "", []))
+            if v not in items:
+                raise lsref.ReferenceError_(f"experiment {e.name}: {name} = '{v}' is not an item of "
+                                            f"{var.declared_type}; accepted: {', '.join(items)}")
+            out[name] = items[v]
+        else:
+            out[name] = v
+    return out
+
+
+def _run_fmpy(fmu: Path, start: dict, inputs: dict[str, np.ndarray], outputs: list[str], e) -> dict:
+    from fmpy import simulate_fmu
+
+    names = [c for c in inputs if c != "time"]
+    table = np.array(list(zip(*(inputs[c] for c in ["time", *names]))),
+                     dtype=[("time", "f8")] + [(c, "f8") for c in names])
+    recorded = list(dict.fromkeys(_ELEMENT.match(o).group(1) if _ELEMENT.match(o) and o not in names else o
+                                  for o in outputs))
+    r = simulate_fmu(str(fmu), start_time=e.start, stop_time=e.stop, step_size=e.step, output_interval=e.step,
+                     start_values=start, input=table, output=recorded, fmi_type="CoSimulation",
+                     terminate=True, validate=False)
+    out = {"time": np.asarray(r["time"], dtype=float)}
+    for o in outputs:
+        m = _ELEMENT.match(o)
+        if o in r.dtype.names:
+            out[o] = np.asarray(r[o], dtype=float)
+        elif m and m.group(1) in r.dtype.names:
+            out[o] = np.asarray(r[m.group(1)], dtype=float).reshape(len(r), -1)[:, int(m.group(2)) - 1]
+    return out
+
+
+def _run_libcosim(fmu: Path, start: dict, inputs: dict[str, np.ndarray], outputs: list[str], e) -> dict:
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimManipulator import CosimManipulator
+    from libcosimpy.CosimObserver import CosimObserver
+    from libcosimpy.CosimSlave import CosimLocalSlave
+
+    log_output_level(CosimLogLevel.ERROR)
+    t = inputs["time"]
+    names = [c for c in inputs if c != "time"]
+    ex = CosimExecution.from_step_size(round(e.step * 1e9))
+    slave = CosimLocalSlave(fmu_path=str(fmu), instance_name="fmu")
+    i = ex.add_local_slave(slave)
+    observer, manipulator = CosimObserver.create_last_value(), CosimManipulator.create_override()
+    ex.add_observer(observer)
+    ex.add_manipulator(manipulator)
+    var = {v.name.decode(): v for v in ex.slave_variables(i)}
+    integer = {n for n, v in var.items() if int(v.type) == 1}
+    for name, v in start.items():
+        (ex.integer_initial_value if name in integer else ex.real_initial_value)(i, var[name].reference, v)
+    for c in names:
+        ex.real_initial_value(i, var[c].reference, float(inputs[c][0]))
+    rows, times = [], []
+    for k in range(len(t) - 1):
+        manipulator.slave_real_values(i, [var[c].reference for c in names], [float(inputs[c][k]) for c in names])
+        if not ex.step(1):
+            break  # libcosim's execution ends on a failed step (a diverged run): the rows so far
+        times.append(t[k + 1])
+        rows.append([observer.last_integer_values(i, [var[c].reference])[0] if c in integer
+                     else observer.last_real_values(i, [var[c].reference])[0] for c in outputs])
+    del ex, manipulator, observer, slave
+    arr = np.array(rows, dtype=float).reshape(len(rows), len(outputs))
+    return {"time": np.asarray(times), **{c: arr[:, j] for j, c in enumerate(outputs)}}
+
+
+def run_experiment(fmu: str | Path, e: lsref.RefExperiment, host: str,
+                   swap: tuple[str, str] | None = None) -> Outcome:
+    """Run one experiment in ``host`` and judge it."""
+    fmu = Path(fmu)
+    t0 = time.perf_counter()
+    inputs = dict(e.inputs)
+    if swap:
+        a, b = swap
+        missing = [s for s in swap if s not in inputs]
+        if missing:
+            raise lsref.ReferenceError_(f"--swap-inputs: {', '.join(missing)} not an input of experiment {e.name}")
+        inputs[a], inputs[b] = e.inputs[b], e.inputs[a]
+    start = _start_values(fmu, e)
+    outputs = e.outputs
+    note = ""
+    fmi3 = read_description(fmu)[2].get("fmiVersion", "").startswith("3")
+    if host in ("libcosim", "ecos"):
+        variables = read_description(fmu)[0]
+        # an enumeration the experiment leaves at the FMU's start value is harmless to a host that ignores them
+        enum_set = [n for n in start if variables[n].type == "Enumeration" and start[n] != variables[n].start]
+        if enum_set:
+            return Outcome(e.name, "not run", f"{host} ignores enumerations, and this experiment sets "
+                           f"{', '.join(f'{n} = {e.parameters[n]}' for n in enum_set)}")
+        start = {n: v for n, v in start.items() if variables[n].type != "Enumeration"}
+        if host == "libcosim" and fmi3:
+            return Outcome(e.name, "not run", "libcosim 0.0.6 imports FMI 2.0 only")
+    if host == "ecos":
+        from . import ecos_host
+
+        refused = ecos_host.unsupported(fmu, outputs)
+        if refused:
+            outputs = [o for o in outputs if o not in refused]
+            note = f" ({len(refused)} output(s) not readable in ecos: {', '.join(refused)})"
+    try:
+        if host == "fmpy":
+            result = _run_fmpy(fmu, start, inputs, outputs, e)
+        elif host == "fmusim":
+            from . import fmusim_host
+
+            r = fmusim_host.run(fmu, start, inputs, outputs, e.step, e.stop, e.start)
+            if r.exit_code not in (0,):
+                return Outcome(e.name, "FAILED", f"fmusim exit code {r.exit_code}: {r.log.strip()[-300:]}",
+                               seconds=time.perf_counter() - t0)
+            result = r.result
+        elif host == "libcosim":
+            result = _run_libcosim(fmu, start, inputs, outputs, e)
+        else:
+            from . import ecos_host
+
+            result = ecos_host.run(fmu, start, inputs, outputs, e.step)
+    except Exception as exc:  # the host's own failure is the verdict of this experiment, not a crash of ours
+        return Outcome(e.name, "FAILED", f"{host}: {exc.__class__.__name__}: {str(exc)[:300]}",
+                       seconds=time.perf_counter() - t0)
+    if host == "libcosim":  # its observer has no row after initialisation: compare from the first step on
+        ref = {k: v[1:] for k, v in e.reference.items()}
+        if "status" in ref and ref["status"][-1] == 1 and len(result["time"]) == len(ref["time"]) - 1:
+            # a diverged run: libcosim ends the execution on the failed step and keeps no row of it
+            ref = {k: v[:-1] for k, v in ref.items()}
+            note += " (ended on the diverging step, as the FMU asked, without its row)"
+        e = lsref.RefExperiment(e.name, e.description, e.parameters, e.inputs, ref, e.step, e.tolerance)
+        note += " (from t1: libcosim records no row after initialisation)"
+    if outputs != e.outputs:
+        e = lsref.RefExperiment(e.name, e.description, e.parameters, e.inputs,
+                                {k: e.reference[k] for k in ("time", *outputs)}, e.step, e.tolerance)
+    diffs = lsref.compare(e, result)
+    worst = max(outputs, key=lambda c: diffs[c])
+    ok = lsref.passed(e, diffs)
+    rows = f"{int(diffs['rows'])}/{int(diffs['rows_reference'])} rows"
+    detail = (f"{rows}, max rel. diff {diffs[worst]:.1e} ({worst}; tolerance {e.tolerance:g})" + note)
+    return Outcome(e.name, "passed" if ok else "FAILED", detail, diffs, time.perf_counter() - t0)
+
+
+def check(fmu: str | Path, host: str = "fmpy", swap: tuple[str, str] | None = None,
+          only: list[str] | None = None) -> list[Outcome]:
+    """Every reference experiment of ``fmu`` (or those named in ``only``) in ``host``."""
+    why = host_unavailable(host)
+    if why:
+        raise lsref.ReferenceError_(f"--host {host}: {why}")
+    experiments = lsref.read(fmu)
+    if only:
+        unknown = sorted(set(only) - {e.name for e in experiments})
+        if unknown:
+            raise lsref.ReferenceError_(f"--only: {', '.join(unknown)} not an experiment of {Path(fmu).name}; "
+                                        f"accepted: {', '.join(e.name for e in experiments)}")
+        experiments = [e for e in experiments if e.name in only]
+    return [run_experiment(fmu, e, host, swap) for e in experiments]
