@@ -2,8 +2,8 @@
 
 * ``RotorCasingContact_in.csv``: every input of the FMU, one row per communication point: ``time, Omega,
   imbalance, clearance_closure, casing_offset.x, casing_offset.y, casing_lobe2.amplitude, ...`` (a run-up through
-  the first critical speed with the reference imbalance; half-way the engine ovalizes the casing: lobe 2 steps to
-  ``RUN["oval"]`` at ``RUN["oval_phase"]``; the other engine inputs at their start values, 0);
+  the first critical speed; half-way the engine ovalizes the casing: lobe 2 steps to ``RUN["oval"]``; every other
+  input moves too, each at its own times (:data:`ENGINE`, :data:`IMBALANCE`), so that a mis-wired host fails);
 * ``RotorCasingContact_ref.csv``: the reference outputs at the same points (FMI 3.0 kit: the per-blade outputs in
   the array columns, ``blade.F_N[1]``, ...);
 * ``RotorCasingContact_ref.opt`` and ``ReadMe.txt``.
@@ -11,10 +11,29 @@
 Every parameter keeps its default (the FMU's start values: g0 = 1 mm, 3D, transient), so any importing tool can
 run it without setting anything but the inputs. The reference comes from the library (``run_transient(hold=h)``),
 which every flavour reproduces to round-off. fmu_src/masters/crosscheck.py runs an FMU against it.
+
+**Reference experiments** (below the kit): shipped inside the FMU (FMI-LS-REF, fmu_src/fmi/lsref.py) and replayed
+by ``rotorub fmu-check`` in any importer; the kit is the ``run_up`` experiment with every blade's force compared.
+
+Each experiment is what a system engineer would check the FMU on: the paper's section-6 transients (2D and 3D, at
+Omega = 3.3 omega_ref and g0 = 0.8 mm, the imbalance ramped over 1 s), a run-up through the first critical speed (the
+cross-check kit's run), a casing ovalizing while the blades rub, an abradable liner worn by the rub, and a
+divergence (a penetration beyond ``max_penetration``: the FMU ends the run, status 1).
+
+**Every input moves in every experiment**, each at its own times and to its own values (:data:`ENGINE`): a host that
+wires two inputs the wrong way round (swaps the casing offsets, the lobe phases, ...) computes another rub and fails
+the experiment's tolerance. The moves are small beside the clearance (at most 0.1 mm), so each experiment stays the
+case it is named after.
+
+The reference results come from the library (``run_transient(hold=h)``, run in pieces between the input changes),
+not from the FMU: the FMU's kernel is the library's, and an importer that runs it as FMI says reproduces these
+numbers to round-off (measured: about 1e-10 of each column's largest value; tolerance 1e-8).
 """
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -48,48 +67,13 @@ def _variables(params):
 
 
 def reference(params=None) -> dict[str, np.ndarray]:
-    """Every input (by name) and the reference outputs (FMI 2.0 names) at the communication points 0, h, ..."""
-    from rotorub_model.analyses.transient import run_transient
-    from rotorub_model.contact import make_contact
-    from rotorub_model.contact.liner import Liner
-    from rotorub_model.structure.model import build_model
+    """Every input (by name) and the reference outputs (FMI 2.0 names) at the communication points 0, h, ...: the
+    ``run_up`` experiment with every blade's normal force."""
     from rotorub_model.structure.params import reference_parameters
 
     p = params or reference_parameters()
-    m = build_model(p)
-    w = _omega(p.normalisation.omega_ref)
-    h, T, t1 = RUN["h"], RUN["duration"], RUN["oval_at"]
-    c = make_contact(m, "3D")
-    # the casing as the FMU holds it: round until t1, then oval (a rigid surface, the engine's input at a step)
-    casing = Liner(c, wears=False)
-    first = run_transient(m, c, w, t_end=t1, t_ramp=0.0, me=p.imbalance.me, record_dt=h, hold=h, liner=casing)
-    casing.set_distortion({2: (RUN["oval"], RUN["oval_phase"])})
-    second = run_transient(m, c, w, t_end=T - t1, t_ramp=0.0, me=p.imbalance.me, record_dt=h, hold=h,
-                           liner=casing, start=first.final_state)
-    n = len(first.t) + len(second.t)
-    t = np.concatenate([[0.0], first.t, second.t])
-    o = {k: np.concatenate([first.outputs[k], second.outputs[k]]) for k in first.outputs}
-    out = {"time": t}
-    # every input of the FMU: the run's speed and imbalance, the others held at their start values
-    for v in scalars(declared(_variables(p), ("fmi2", "native"))):
-        if v.causality == "input":
-            out[v.name] = np.full(n + 1, float(v.start))
-    out["Omega"] = np.array([w(x) for x in t])
-    out["imbalance"] = np.full(n + 1, p.imbalance.me)
-    # held over the step that starts at each row: the row at t1 starts the oval casing's first step
-    out["casing_lobe2.amplitude"] = np.where(t >= t1 - 0.5 * h, RUN["oval"], 0.0)
-    out["casing_lobe2.phase"] = np.full(n + 1, RUN["oval_phase"])
-    zero = np.zeros(1)
-    out["friction_torque"] = np.concatenate([zero, o["friction_torque"]])
-    out["gap_min"] = np.concatenate([[p.contact.g0], o["gap"].min(axis=(1, 2))])
-    out["n_contact"] = np.concatenate([zero, (o["F_N"] > 0).sum(axis=1)])
-    for k, ax in enumerate("xy"):
-        out[f"disk_displacement.{ax}"] = np.concatenate([zero, o["disk_fixed"][:, k]])
-    for k, ax in enumerate("xyz"):
-        out[f"casing_force.{ax}"] = np.concatenate([zero, o["casing_force_fixed"][:, k]])
-    for j in range(p.blades.count):
-        out[f"blade[{j + 1}].F_N"] = np.concatenate([zero, o["F_N"][:, j]])
-    return out
+    run_up = next(e for e in experiments() if e.name == "run_up")
+    return experiment_reference(replace(run_up, outputs=outputs(p.blades.count)), p)
 
 
 def columns3(params=None) -> dict[str, str]:
@@ -112,10 +96,10 @@ def write_kit(dest: str | Path, params=None, fmi: str = "2.0") -> dict[str, Path
     readme = f"""{NAME}: FMI cross-check kit (co-simulation)
 
 A run-up with blade-tip / casing rub: the spin speed Omega rises linearly from {RUN['speed_from']} to
-{RUN['speed_to']} x omega_ref (through the first critical speed) in {RUN['duration']} s, the imbalance is held at
-the reference value; at t = {RUN['oval_at']} s the engine ovalizes the casing (casing_lobe2.amplitude steps to
-{RUN['oval'] * 1e3:g} mm, casing_lobe2.phase {RUN['oval_phase']:g} rad); the engine's other inputs
-({', '.join(i for i in inputs if i not in ('Omega', 'imbalance') and not i.startswith('casing_lobe2'))}) stay 0;
+{RUN['speed_to']} x omega_ref (through the first critical speed) in {RUN['duration']} s; at t = {RUN['oval_at']} s the
+engine ovalizes the casing (casing_lobe2.amplitude steps to {RUN['oval'] * 1e3:g} mm). Every other input moves too, each at
+its own times and to its own values (the imbalance by +15 % and -10 %, the clearance closure, the casing offsets and
+the lobes by at most 0.1 mm): a host that mis-wires two inputs computes another rub and fails the comparison;
 every parameter keeps its default (3D contact, transient mode, g0 = 1 mm).
 
 Run {NAME}.fmu from 0 to {RUN['duration']} s with a fixed communication step of {RUN['h']} s, the inputs of
@@ -136,3 +120,219 @@ same run, continued from each early return to the next communication point, give
 """ if fmi == "3.0" else "")
     return kit.write_kit(dest, NAME, ref["time"], {k: ref[k] for k in inputs},
                      {rename.get(c, c): ref[c] for c in outs}, RUN["h"], readme)
+
+
+# ----------------------------------------------------------------------- reference experiments (FMI-LS-REF)
+TOLERANCE = 1e-8  # of each output's largest absolute value over the run (round-off: about 1e-10)
+
+# the engine's inputs, moving in every experiment: input -> [(fraction of the experiment's duration, value)], held
+# from there on (the input's start value before)
+ENGINE: dict[str, list[tuple[float, float]]] = {
+    "clearance_closure": [(0.125, 0.05e-3), (0.625, 0.1e-3)],
+    "casing_offset.x": [(0.175, 0.02e-3), (0.725, -0.01e-3)],
+    "casing_offset.y": [(0.325, -0.03e-3), (0.875, 0.015e-3)],
+    "casing_lobe2.amplitude": [(0.275, 0.02e-3)],
+    "casing_lobe2.phase": [(0.0, 0.5), (0.475, 0.7)],
+    "casing_lobe3.amplitude": [(0.2, 0.04e-3)],
+    "casing_lobe3.phase": [(0.0, 0.2), (0.575, 0.9)],
+    "casing_lobe4.amplitude": [(0.35, 0.03e-3)],
+    "casing_lobe4.phase": [(0.0, 1.1), (0.675, 0.4)],
+}
+# the imbalance where an experiment does not drive it itself (a ramp, or its own steps): factors of the reference's
+IMBALANCE = [(0.4, 1.15), (0.8, 0.9)]
+
+EXP_OUTPUTS = ("friction_torque", "gap_min", "n_contact", "disk_displacement.x", "disk_displacement.y",
+           "casing_force.x", "casing_force.y", "casing_force.z", "blade[1].F_N")
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """One reference experiment: parameters (FMI start values), a spin-speed ramp, input steps, a duration."""
+
+    name: str
+    description: str
+    duration: float  # s
+    speed: tuple[float, float]  # Omega / omega_ref at t = 0 and at t = duration (linear between)
+    parameters: dict[str, float | int] = field(default_factory=dict)
+    # input steps on top of ENGINE (they replace an input's ENGINE list): input -> [(t, value)]
+    stimuli: dict[str, list[tuple[float, float]]] = field(default_factory=dict)
+    imbalance_ramp: float = 0.0  # s: the imbalance rises from 0 to the reference over this time (0: held)
+    outputs: tuple[str, ...] = EXP_OUTPUTS
+    h: float = 1e-3
+    tolerance: float = TOLERANCE
+
+
+def experiments() -> list[Experiment]:
+    """The contact FMU's experiments (parameters by their FMI names; enumerations by value)."""
+    return [
+        Experiment("section6_3D", "The paper's section-6 transient in 3D: Omega = 3.3 omega_ref, g0 = 0.8 mm, the "
+                   "imbalance ramped over 1 s; three blades touch, the rub settles on the stable static solution",
+                   1.5, (3.3, 3.31), {"formulation": 2, "g0": 0.8e-3}, imbalance_ramp=1.0),
+        Experiment("section6_2D", "The paper's section-6 transient in 2D (point blade tips on a cylindrical casing), "
+                   "same point and ramp", 1.5, (3.3, 3.31), {"formulation": 1, "g0": 0.8e-3}, imbalance_ramp=1.0),
+        Experiment("run_up", "A run-up through the first critical speed (3.2 to 3.8 omega_ref in 2 s), the casing "
+                   "ovalized half-way (lobe 2 steps to 0.3 mm at t = 1 s); the cross-check kit's run",
+                   2.0, (3.2, 3.8), {}, {"casing_lobe2.amplitude": [(1.0, 0.3e-3)]}),
+        Experiment("oval_casing", "An ovalizing casing (lobe 2: 0.1, 0.2, 0.3 mm at 0.3, 0.6, 0.9 s) under rubbing "
+                   "blades at 3.3 omega_ref, g0 = 0.5 mm", 1.2, (3.3, 3.35), {"g0": 0.5e-3},
+                   {"casing_lobe2.amplitude": [(0.3, 0.1e-3), (0.6, 0.2e-3), (0.9, 0.3e-3)]}),
+        Experiment("wear", "The rub against an abradable liner (yield force 100 N): the liner is cut where the tips "
+                   "press it, g0 = 0.3 mm at 3.4 omega_ref", 1.0, (3.4, 3.42), {"g0": 0.3e-3, "liner": 2},
+                   outputs=EXP_OUTPUTS[:8] + ("wear.depth_max",)),
+        Experiment("divergence", "A blade lost (the imbalance steps to 0.5 kg m at t = 0.1 s) with g0 = 0.1 mm in 3D: "
+                   "the penetration passes max_penetration (3 mm) about 40 ms later and the FMU ends the run "
+                   "(terminate, status 1)", 0.3, (3.3, 3.31), {"g0": 0.1e-3}, {"imbalance": [(0.1, 0.5)]},
+                   outputs=EXP_OUTPUTS[:8] + ("status",)),
+    ]
+
+
+def _at(steps: list[tuple[float, float]], t: float, start: float) -> float:
+    v = start
+    for ts, x in steps:
+        if ts <= t + 1e-12:
+            v = x
+    return v
+
+
+def stimuli_of(e: Experiment) -> dict[str, list[tuple[float, float]]]:
+    """Every engine input's steps in this experiment, in seconds (ENGINE scaled to its duration, with the
+    experiment's own steps in place of some)."""
+    def snap(f: float) -> float:  # on a communication point: an input changes at the start of a step
+        return round(f * e.duration / e.h) * e.h
+
+    return {**{k: [(snap(f), v) for f, v in s] for k, s in ENGINE.items()}, **e.stimuli}
+
+
+def experiment_reference(e: Experiment, params=None) -> dict[str, np.ndarray]:
+    """``time``, every input of the FMU and the experiment's outputs at the communication points 0, h, ..., from
+    the library (the FMU's inputs held over each step, as a co-simulation master holds them). A run that
+    diverges ends at the step where it did (its last row: that step's outputs)."""
+    from rotorub_model.analyses.transient import run_transient
+    from rotorub_model.contact import make_contact
+    from rotorub_model.contact.liner import Liner
+    from rotorub_model.structure.model import build_model
+    from rotorub_model.structure.params import reference_parameters
+
+    from ...fmi.variables import declared, scalars
+
+    p = params or reference_parameters()
+    m = build_model(p)
+    defaults = {v.name: v.start for v in cv.variables(cv.Defaults.from_parameters(p, m)) if v.settable}
+    par = {**defaults, **e.parameters}
+    w_ref = p.normalisation.omega_ref
+    h, T = e.h, e.duration
+    a, b = e.speed
+
+    def omega(t: float) -> float:
+        return w_ref * (a + (b - a) * min(max(t / T, 0.0), 1.0))
+
+    me_ref = p.imbalance.me
+    formulation = {1: "2D", 2: "3D"}[int(par["formulation"])]
+    c = make_contact(m, formulation, g0=float(par["g0"]))
+    wears = int(par["liner"]) == 2
+    liner = Liner.for_model(m, c, wears=True) if wears else Liner(c, wears=False)
+    steps = stimuli_of(e)
+    inputs = [v.name for v in scalars(declared(cv.variables(cv.Defaults.from_parameters(p, m)), ("fmi2", "native")))
+              if v.causality == "input"]
+    n_steps = int(round(T / h))
+    grid = np.arange(n_steps + 1) * h
+    own_imbalance = "imbalance" in steps or e.imbalance_ramp > 0
+    imbalance = [(round(f * T / h) * h, x) for f, x in IMBALANCE]
+    cuts = sorted({int(round(t / h)) for s in [*steps.values(), [] if own_imbalance else imbalance] for t, _ in s
+                   if 0 < t < T} | {n_steps})
+    if e.imbalance_ramp > 0:  # the ramp is an input history: one piece per step while it rises
+        cuts = sorted(set(cuts) | set(range(1, int(round(e.imbalance_ramp / h)) + 1)))
+    wears = int(par["liner"]) == 2
+    if wears:  # the FMU's wear outputs are the liner's summary after each step: one piece per step
+        cuts = list(range(1, n_steps + 1))
+
+    def me_at(k: int) -> float:
+        if "imbalance" in steps:
+            return _at(steps["imbalance"], k * h, me_ref)
+        if e.imbalance_ramp > 0:
+            return me_ref * min(k * h / e.imbalance_ramp, 1.0)
+        return me_ref * _at(imbalance, k * h, 1.0)
+
+    rows: list[dict[str, np.ndarray]] = []
+    state, k0, diverged, t_stop = None, 0, False, math.inf
+    for k1 in cuts:
+        t0 = k0 * h
+        val = {name: _at(s, t0, float(defaults[name])) for name, s in steps.items()}
+        liner.set_inputs(closure=val["clearance_closure"], offset=(val["casing_offset.x"], val["casing_offset.y"]),
+                         distortion={n: (val[f"casing_lobe{n}.amplitude"], val[f"casing_lobe{n}.phase"])
+                                     for n in (2, 3, 4)})
+        r = run_transient(m, c, omega, t_end=(k1 - k0) * h, t_ramp=0.0, me=me_at(k0), record_dt=h, hold=h,
+                          liner=liner, start=state, max_penetration=float(par["max_penetration"]),
+                          wear_record_dt=h)
+        o = r.outputs
+        piece = {"F_N": o["F_N"], "gap": o["gap"].min(axis=tuple(range(1, o["gap"].ndim))),
+                 "friction_torque": o["friction_torque"], "disk": o["disk_fixed"][:, :2],
+                 "casing": o["casing_force_fixed"][:, :3]}
+        if wears:
+            piece["wear"] = np.array([liner.summary()["depth_max"]])
+        rows.append(piece)
+        state, k0 = r.final_state, k1
+        if r.penetration_limit_hit:
+            diverged = True
+            t_stop = r.t_end
+            break
+    cat = {k: np.concatenate([piece[k] for piece in rows]) for k in rows[0]}
+    n = len(cat["F_N"])  # steps completed
+    # a diverged run: the FMU ends the step where the penetration passed the limit, with the outputs of the state
+    # it stopped in (inside the step) and status 1; that row's time and status are the reference, its other values
+    # are not (NaN: not compared)
+    # the limit crossed at a step's very end: that row is the diverged state's, and the FMU ends there
+    at_row = diverged and abs(t_stop - n * h) < 1e-9 * max(h, 1.0)
+    extra = int(diverged and not at_row)
+    t = grid[:n + 1 + extra]
+    out: dict[str, np.ndarray] = {"time": t}
+    for name in inputs:
+        if name == "Omega":
+            out[name] = np.array([omega(x) for x in t])
+        elif name == "imbalance":  # a ramp or steps
+            out[name] = np.array([me_at(k) for k in range(len(t))])
+        else:
+            out[name] = np.array([_at(steps.get(name, []), x, float(defaults[name])) for x in t])
+    tail = np.full(extra, np.nan)
+
+    def col(first: float, values: np.ndarray) -> np.ndarray:
+        return np.concatenate([[first], values, tail])
+
+    full = {"friction_torque": col(0.0, cat["friction_torque"]), "gap_min": col(float(par["g0"]), cat["gap"]),
+            "n_contact": col(0.0, (cat["F_N"] > 0).sum(axis=1)),
+            "disk_displacement.x": col(0.0, cat["disk"][:, 0]), "disk_displacement.y": col(0.0, cat["disk"][:, 1]),
+            "casing_force.x": col(0.0, cat["casing"][:, 0]), "casing_force.y": col(0.0, cat["casing"][:, 1]),
+            "casing_force.z": col(0.0, cat["casing"][:, 2]),
+            "status": np.concatenate([np.zeros(n + 1 - int(at_row)), np.ones(int(diverged))])}
+    for j in range(p.blades.count):
+        full[f"blade[{j + 1}].F_N"] = col(0.0, cat["F_N"][:, j])
+    if wears:
+        full["wear.depth_max"] = col(0.0, cat["wear"])
+    out.update({k: full[k] for k in e.outputs})
+    return out
+
+
+
+def ref_experiments(params=None, fmi: str = "2.0") -> list:
+    """The experiments as they travel in the FMU (fmu_src/fmi/lsref.py): enumerations by item name, the FMI 3.0
+    FMU's array elements as ``name[k]`` columns, every parameter the reference depends on set explicitly."""
+    from rotorub_model.structure.params import reference_parameters
+
+    from ...fmi.lsref import RefExperiment
+
+    p = params or reference_parameters()
+    variables = cv.variables(cv.Defaults.from_parameters(p))
+    enum_items = {name: [item for item, _ in items] for name, items in cv.MODEL.enumerations.items()}
+    by_name = {v.name: v for v in variables}
+    rename = kit.element_columns(variables) if fmi == "3.0" else {}
+    out = []
+    for e in experiments():
+        ref = experiment_reference(e, p)
+        pars: dict[str, float | int | str] = {}
+        for name, value in {"formulation": 2, "liner": 1, **e.parameters}.items():
+            v = by_name[name]
+            pars[name] = enum_items[v.declared_type][int(value) - 1] if v.type == "Enumeration" else value
+        inputs = {k: ref[k] for k in ref if k not in e.outputs}
+        reference_cols = {"time": ref["time"], **{rename.get(c, c): ref[c] for c in e.outputs}}
+        out.append(RefExperiment(e.name, e.description, pars, inputs, reference_cols, e.h, e.tolerance))
+    return out
