@@ -119,7 +119,7 @@ def _run_check(ns: argparse.Namespace) -> dict:
     lines += ["  " + o.line() for o in outcomes]
     summary = {"fmu": str(ns.fmu), "host": ns.host, "host_version": version,
                "swapped_inputs": ns.swap_inputs, "experiments": [o.__dict__ for o in outcomes]}
-    if ns.record and not ns.swap_inputs:
+    if ns.record and not ns.swap_inputs and ran:  # an importer that cannot run one of them: nothing to record
         summary["recorded"] = str(compatibility.record(ns.fmu, ns.host, version, outcomes, ns.record))
     lines.append(("FAILED: " + ", ".join(o.experiment for o in failed) + f" ({len(failed)} of {len(ran)} run)")
                  if failed else f"All {len(ran)} experiments run passed" + (

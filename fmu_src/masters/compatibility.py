@@ -24,7 +24,7 @@ ROOT = Path(__file__).resolve().parents[2] / "compatibility"
 
 def _build_name(fmu: Path, root) -> str:
     tool = root.get("generationTool", "")
-    flavour = "pythonfmu" if "pythonfmu" in tool else "native"
+    flavour = "pythonfmu" if "pythonfmu" in tool.lower() else "native"
     name = root.get("modelName", fmu.stem)
     return f"{name}-{flavour}" if name == "RotorCasingContact" else name
 

@@ -55,10 +55,10 @@ def host_version(host: str) -> str:
     if host == "libcosim":
         from importlib.metadata import version
 
-        return "libcosimpy " + version("libcosimpy")
-    from . import ecos_host
+        return version("libcosimpy")  # libcosimpy's version (it bundles libcosim's build of the same release)
+    from importlib.metadata import version
 
-    return ecos_host.version()
+    return version("ecospy")  # it bundles libecosc of the same version
 
 
 def host_unavailable(host: str) -> str | None:

@@ -97,9 +97,9 @@ def write_kit(dest: str | Path, params=None, fmi: str = "2.0") -> dict[str, Path
 
 A run-up with blade-tip / casing rub: the spin speed Omega rises linearly from {RUN['speed_from']} to
 {RUN['speed_to']} x omega_ref (through the first critical speed) in {RUN['duration']} s; at t = {RUN['oval_at']} s the
-engine ovalizes the casing (casing_lobe2.amplitude steps to {RUN['oval'] * 1e3:g} mm). Every other input moves too, each at
-its own times and to its own values (the imbalance by +15 % and -10 %, the clearance closure, the casing offsets and
-the lobes by at most 0.1 mm): a host that mis-wires two inputs computes another rub and fails the comparison;
+engine ovalizes the casing (casing_lobe2.amplitude steps to {RUN['oval'] * 1e3:g} mm). Every other input moves
+too, each at its own times and to its own values (the imbalance by +15 % and -10 %, the clearance closure, the
+casing offsets and the lobes by at most 0.1 mm): a host that mis-wires two inputs computes another rub and fails;
 every parameter keeps its default (3D contact, transient mode, g0 = 1 mm).
 
 Run {NAME}.fmu from 0 to {RUN['duration']} s with a fixed communication step of {RUN['h']} s, the inputs of
