@@ -94,22 +94,23 @@ def _add_check_args(sp: argparse.ArgumentParser) -> None:
                     help="hand the host inputs A and B the wrong way round (a mis-wired connection: the experiments "
                          "must fail)")
     sp.add_argument("--record", default=None, metavar="DIR",
-                    help="write the compatibility information (the FMI tools page's layout) under DIR: "
-                         "DIR/<FMU>/<importer>/<version>/<platform>/ with what the importer produced and the verdict")
+                    help="write the compatibility information (the FMI cross-check layout) under DIR: "
+                         "DIR/<fmi>/cs/<platform>/<importer>/<version>/rotorub/<version>/<FMU>/ with the verdict "
+                         "and what the importer produced")
     sp.set_defaults(out=None)
 
 
 def _run_check(ns: argparse.Namespace) -> dict:
     from rotorub_model.errors import ParameterError
 
-    from .fmi.lsref import ReferenceError_
+    from .fmi.lsref import ExperimentError
     from .masters import compatibility, replay
 
     if not Path(ns.fmu).is_file():
         raise ParameterError(f"fmu-check: FMU '{ns.fmu}' not found (give the path of a .fmu file)")
     try:
         outcomes = replay.check(ns.fmu, ns.host, tuple(ns.swap_inputs) if ns.swap_inputs else None, ns.only)
-    except ReferenceError_ as exc:
+    except ExperimentError as exc:
         raise ParameterError(f"fmu-check: {exc}") from None
     version = replay.host_version(ns.host)
     failed = [o for o in outcomes if o.verdict == "FAILED"]

@@ -14,6 +14,8 @@ crosscheck.py runs any FMU against any kit. Numbers are written with ``repr`` (t
 from __future__ import annotations
 
 import csv
+import io
+import math
 from pathlib import Path
 
 import numpy as np
@@ -42,21 +44,38 @@ def write_kit(dest: str | Path, identifier: str, time: np.ndarray, inputs: dict[
     return files
 
 
-def write_csv(path: Path, columns: dict[str, np.ndarray]) -> None:
+def csv_text(columns: dict[str, np.ndarray]) -> str:
+    """The table as CSV text: a header, then one row per entry, numbers by ``repr`` (they read back exactly); a NaN
+    is an empty cell (no value there: a reference's cell that is not compared)."""
     names = list(columns)
-    n = len(columns[names[0]])
-    with path.open("w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(names)
-        for k in range(n):
-            w.writerow([repr(float(columns[c][k])) for c in names])
+    buf = io.StringIO()
+    w = csv.writer(buf)
+    w.writerow(names)
+    for k in range(len(columns[names[0]])):
+        w.writerow(["" if math.isnan(x := float(columns[c][k])) else repr(x) for c in names])
+    return buf.getvalue()
+
+
+def parse_csv(text: str) -> dict[str, np.ndarray]:
+    """A table written by :func:`csv_text` (an empty cell reads as NaN); ValueError if a cell is not a number or a
+    row has another length than the header."""
+    rows = list(csv.reader(io.StringIO(text)))
+    if not rows:
+        raise ValueError("no header")
+    head = rows[0]
+    if any(len(r) != len(head) for r in rows[1:]):
+        raise ValueError(f"every row must have the header's {len(head)} cells")
+    body = np.array([[float(x) if x != "" else math.nan for x in r] for r in rows[1:]], dtype=float)
+    body = body.reshape(len(rows) - 1, len(head))
+    return {name: body[:, k] for k, name in enumerate(head)}
+
+
+def write_csv(path: Path, columns: dict[str, np.ndarray]) -> None:
+    Path(path).write_text(csv_text(columns), newline="")
 
 
 def read_csv(path: str | Path) -> dict[str, np.ndarray]:
-    with Path(path).open() as f:
-        rows = list(csv.reader(f))
-    head, body = rows[0], np.array(rows[1:], dtype=float)
-    return {name: body[:, k] for k, name in enumerate(head)}
+    return parse_csv(Path(path).read_text())
 
 
 def element_columns(variables: list[Var]) -> dict[str, str]:

@@ -22,8 +22,6 @@ is not a reference (the state a diverged run stopped in, inside its last step).
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 import shutil
 import tempfile
@@ -33,6 +31,8 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 import numpy as np
+
+from .crosscheck import csv_text, parse_csv
 
 FOLDER = "extra/org.fmi-standard.fmi-ls-ref/"
 MANIFEST = FOLDER + "fmi-ls-manifest.xml"
@@ -46,7 +46,7 @@ ET.register_namespace("fmi-ls", LS_NS)
 ET.register_namespace("ssv", SSV_NS)
 
 
-class ReferenceError_(ValueError):
+class ExperimentError(ValueError):
     """An FMU's reference experiments cannot be read (missing, damaged): the message names the file."""
 
 
@@ -75,27 +75,14 @@ class RefExperiment:
         return [c for c in self.reference if c != "time"]
 
 
-def _csv_bytes(columns: dict[str, np.ndarray]) -> bytes:
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    names = list(columns)
-    w.writerow(names)
-    for k in range(len(columns[names[0]])):
-        w.writerow(["" if math.isnan(float(columns[c][k])) else repr(float(columns[c][k])) for c in names])
-    return buf.getvalue().encode()
-
-
 def _read_csv(data: bytes, where: str) -> dict[str, np.ndarray]:
-    rows = list(csv.reader(io.StringIO(data.decode())))
-    if len(rows) < 2:
-        raise ReferenceError_(f"{where}: no rows")
     try:
-        body = np.array([[float(x) if x != "" else np.nan for x in r] for r in rows[1:]], dtype=float)
-    except ValueError as exc:
-        raise ReferenceError_(f"{where}: not a table of numbers ({exc})") from None
-    if body.shape[1] != len(rows[0]) or rows[0][0] != "time":
-        raise ReferenceError_(f"{where}: expected a header starting with 'time' and as many cells in every row")
-    return {n: body[:, k] for k, n in enumerate(rows[0])}
+        table = parse_csv(data.decode())
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise ExperimentError(f"{where}: not a table of numbers ({exc})") from None
+    if next(iter(table), None) != "time" or len(table["time"]) < 2:
+        raise ExperimentError(f"{where}: expected a header starting with 'time' and at least two rows")
+    return table
 
 
 def _ssv(name: str, values: dict[str, float | int | str]) -> bytes:
@@ -114,7 +101,7 @@ def _read_ssv(data: bytes, where: str) -> dict[str, float | int | str]:
     try:
         root = ET.fromstring(data)
     except ET.ParseError as exc:
-        raise ReferenceError_(f"{where}: not XML ({exc})") from None
+        raise ExperimentError(f"{where}: not XML ({exc})") from None
     out: dict[str, float | int | str] = {}
     for p in root.iter(f"{{{SSV_NS}}}Parameter"):
         v = next(iter(p))
@@ -163,8 +150,8 @@ def files_of(model: str, experiments: list[RefExperiment]) -> dict[str, bytes]:
         if len(e.outputs) > 10:
             raise ValueError(f"{model}: experiment {e.name} compares {len(e.outputs)} outputs (at most 10)")
         out[FOLDER + f"{e.name}.ssv"] = _ssv(e.name, e.parameters)
-        out[FOLDER + f"{e.name}_in.csv"] = _csv_bytes(e.inputs)
-        out[FOLDER + f"{e.name}_ref.csv"] = _csv_bytes(e.reference)
+        out[FOLDER + f"{e.name}_in.csv"] = csv_text(e.inputs).encode()
+        out[FOLDER + f"{e.name}_ref.csv"] = csv_text(e.reference).encode()
         related += [(f"{e.name}.ssv", "parameter", "application/x-ssp-parameter-set", f"{e.name}: parameters"),
                     (f"{e.name}_in.csv", "testcase", "text/csv", f"{e.name}: stimuli, every input"),
                     (f"{e.name}_ref.csv", "result", "text/csv", f"{e.name}: reference results")]
@@ -199,32 +186,32 @@ def read(fmu: str | Path) -> list[RefExperiment]:
     try:
         z = zipfile.ZipFile(fmu)
     except (OSError, zipfile.BadZipFile) as exc:
-        raise ReferenceError_(f"{fmu}: not an FMU (a zip archive) ({exc})") from None
+        raise ExperimentError(f"{fmu}: not an FMU (a zip archive) ({exc})") from None
     with z:
         names = set(z.namelist())
         if EXPERIMENTS not in names:
-            raise ReferenceError_(f"{fmu}: carries no reference experiments ({EXPERIMENTS} missing; FMI-LS-REF)")
+            raise ExperimentError(f"{fmu}: carries no reference experiments ({EXPERIMENTS} missing; FMI-LS-REF)")
 
         def get(name: str) -> bytes:
             if FOLDER + name not in names:
-                raise ReferenceError_(f"{fmu}: {FOLDER + name} missing (named by {EXPERIMENTS})")
+                raise ExperimentError(f"{fmu}: {FOLDER + name} missing (named by {EXPERIMENTS})")
             return z.read(FOLDER + name)
 
         try:
             root = ET.fromstring(z.read(EXPERIMENTS))
         except ET.ParseError as exc:
-            raise ReferenceError_(f"{fmu}: {EXPERIMENTS} is not XML ({exc})") from None
+            raise ExperimentError(f"{fmu}: {EXPERIMENTS} is not XML ({exc})") from None
         out = []
         for x in root.findall("Experiment"):
             name = x.get("name", "?")
             try:
                 step, tol = float(x.get("stepSize")), float(x.get("tolerance"))
             except (TypeError, ValueError):
-                raise ReferenceError_(f"{fmu}: experiment {name}: stepSize and tolerance must be numbers") from None
+                raise ExperimentError(f"{fmu}: experiment {name}: stepSize and tolerance must be numbers") from None
             src = {k: x.find(k).get("source") for k in ("Parameters", "Stimuli", "References")
                    if x.find(k) is not None}
             if len(src) != 3:
-                raise ReferenceError_(f"{fmu}: experiment {name}: Parameters, Stimuli and References expected")
+                raise ExperimentError(f"{fmu}: experiment {name}: Parameters, Stimuli and References expected")
             out.append(RefExperiment(name, x.get("description", ""), _read_ssv(get(src["Parameters"]), name),
                                      _read_csv(get(src["Stimuli"]), src["Stimuli"]),
                                      _read_csv(get(src["References"]), src["References"]), step, tol))

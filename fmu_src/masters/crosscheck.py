@@ -6,7 +6,8 @@ step) and record the reference's output columns after initialisation and after e
 * :func:`run_fmpy`: FMI 2.0 through fmpy's FMU2Slave;
 * :func:`run_fmi3`: FMI 3.0 through fmpy's FMU3Slave (fmi3.py), with or without early return (continued from each
   early return to the next communication point); a column ``name[k]`` is element k of the array ``name``;
-* :func:`run_libcosim`: FMI 2.0 through OSP libcosim's fixed-step algorithm (inputs by an override manipulator);
+* :func:`run_libcosim`: FMI 2.0 through OSP libcosim's fixed-step algorithm (inputs by an override manipulator;
+  :func:`libcosim_table` runs any input table so, start values too);
 * :func:`compare`: the largest difference of each output against the reference, relative to its largest value.
 """
 
@@ -120,6 +121,16 @@ def run_fmi3(fmu: str | Path, kit: str | Path, early_return: bool = False) -> di
 def run_libcosim(fmu: str | Path, kit: str | Path) -> dict[str, np.ndarray]:
     """The kit's run through OSP libcosim (its fixed-step algorithm, inputs by an override manipulator); its
     observer has the outputs after each step (not after initialisation)."""
+    inp, ref = kit_of(kit)
+    return libcosim_table(fmu, inp, _columns(ref), float(inp["time"][1] - inp["time"][0]))
+
+
+def libcosim_table(fmu: str | Path, inputs: dict[str, np.ndarray], outputs: list[str], step: float,
+                   start: dict[str, float | int] | None = None, stop_on_failure: bool = False) -> dict[str, np.ndarray]:
+    """An input table's run through OSP libcosim: ``start`` values and the first row set as initial values, each
+    row held over the step that starts there (an override manipulator), ``outputs`` after each step (libcosim's
+    observer has no row after initialisation). A failed step raises, or with ``stop_on_failure`` ends the run
+    with the rows so far (libcosim's execution stops there: a diverged run)."""
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimManipulator import CosimManipulator
@@ -127,11 +138,9 @@ def run_libcosim(fmu: str | Path, kit: str | Path) -> dict[str, np.ndarray]:
     from libcosimpy.CosimSlave import CosimLocalSlave
 
     log_output_level(CosimLogLevel.ERROR)
-    inp, ref = kit_of(kit)
-    ins, outs = _columns(inp), _columns(ref)
-    t = inp["time"]
-    h = float(t[1] - t[0])
-    ex = CosimExecution.from_step_size(round(h * 1e9))
+    t = inputs["time"]
+    ins = _columns(inputs)
+    ex = CosimExecution.from_step_size(round(step * 1e9))
     slave = CosimLocalSlave(fmu_path=str(fmu), instance_name="rotor")
     i = ex.add_local_slave(slave)
     observer = CosimObserver.create_last_value()
@@ -140,19 +149,23 @@ def run_libcosim(fmu: str | Path, kit: str | Path) -> dict[str, np.ndarray]:
     ex.add_manipulator(manipulator)
     refs = {v.name.decode(): v.reference for v in ex.slave_variables(i)}
     integer = {v.name.decode() for v in ex.slave_variables(i) if int(v.type) == 1}  # libcosim's variable types
+    for name, v in (start or {}).items():
+        (ex.integer_initial_value if name in integer else ex.real_initial_value)(i, refs[name], v)
     in_refs = [refs[c] for c in ins]
     for c, r in zip(ins, in_refs):
-        ex.real_initial_value(i, r, float(inp[c][0]))
+        ex.real_initial_value(i, r, float(inputs[c][0]))
     rows = []
     for k in range(len(t) - 1):
-        manipulator.slave_real_values(i, in_refs, [float(inp[c][k]) for c in ins])
+        manipulator.slave_real_values(i, in_refs, [float(inputs[c][k]) for c in ins])
         if not ex.step(1):
+            if stop_on_failure:
+                break
             raise RuntimeError(f"libcosim step {k} failed")
         rows.append([observer.last_integer_values(i, [refs[c]])[0] if c in integer
-                     else observer.last_real_values(i, [refs[c]])[0] for c in outs])
+                     else observer.last_real_values(i, [refs[c]])[0] for c in outputs])
     del ex, manipulator, observer, slave
-    arr = np.array(rows, dtype=float)
-    return {"time": t[1:], **{c: arr[:, j] for j, c in enumerate(outs)}}
+    arr = np.array(rows, dtype=float).reshape(len(rows), len(outputs))
+    return {"time": t[1:len(rows) + 1], **{c: arr[:, j] for j, c in enumerate(outputs)}}
 
 
 def compare(result: dict[str, np.ndarray], kit: str | Path) -> dict[str, float]:

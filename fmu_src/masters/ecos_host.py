@@ -67,23 +67,6 @@ def available() -> str | None:
     return None
 
 
-def version() -> str:
-    """ecospy's version and its engine library's ('ecospy 0.7.2 (libecosc v0.7.2)'), or why there is none."""
-    from importlib.metadata import PackageNotFoundError
-    from importlib.metadata import version as dist_version
-
-    try:
-        package = dist_version("ecospy")
-    except PackageNotFoundError:
-        return "ecospy not installed"
-    reason = available()
-    if reason is not None:
-        return f"ecospy {package} (engine unavailable: {reason})"
-    from ecospy import EcosLib
-
-    return f"ecospy {package} (libecosc {EcosLib.version()})"
-
-
 @dataclass(frozen=True)
 class _Var:
     name: str

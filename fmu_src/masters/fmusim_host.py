@@ -3,8 +3,8 @@
 Nobody here wrote fmusim: a run through it checks the FMUs as a system engineer's tool reads them (their model
 description, their status semantics), not as our own masters do. It is built once from the sources in
 ``../shared/hosts/fmusim-0.0.39/`` (beside the repository; ``ROTORUB_HOSTS`` names another folder holding
-``fmusim-0.0.39/``) with Debian's sundials, minizip, libxml2 and zlib, into a cache keyed by the sources' hash
-(``ROTORUB_CACHE`` or ``~/.cache/rotorub``); ``ROTORUB_FMUSIM`` names a ready executable instead.
+``fmusim-0.0.39/``) with Debian's sundials, minizip, libxml2 and zlib, into the kernel's cache (``hosts/``, keyed
+by the sources' hash); ``ROTORUB_FMUSIM`` names a ready executable instead.
 
 :func:`run` gives fmusim what a user would: ``--start-value`` per parameter, an input CSV (fmusim interpolates a
 continuous input linearly between rows and reads it at each communication point: the row's value there, to an
@@ -26,6 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..fmi.crosscheck import write_csv
+
 VERSION = "0.0.39"
 _ELEMENT = re.compile(r"^(.*)\[(\d+)\]$")
 PACKAGES = ("gcc", "libsundials-dev", "libminizip-dev", "libxml2-dev", "zlib1g-dev")
@@ -39,7 +41,9 @@ def sources() -> Path:
 
 
 def _cache() -> Path:
-    return Path(os.environ.get("ROTORUB_CACHE") or Path.home() / ".cache" / "rotorub") / "hosts"
+    from rotorub_model.kernel import cache_dir  # the one cache of the project (ROTORUB_CACHE_DIR, XDG, ~/.cache)
+
+    return cache_dir() / "hosts"
 
 
 def available() -> str | None:
@@ -84,10 +88,6 @@ def executable() -> Path:
         dest.parent.mkdir(exist_ok=True)
         os.replace(Path(tmp) / "fmusim", dest)  # a rename: a concurrent build replaces it with the same file
     return dest
-
-
-def version() -> str:
-    return VERSION
 
 
 @dataclass
@@ -151,12 +151,7 @@ def run(fmu: str | Path, start_values: dict[str, float | int | str], inputs: dic
             args += ["--output-variable", name]
         if inputs is not None:
             in_csv = tmp_p / "in.csv"
-            names = list(inputs)
-            with in_csv.open("w", newline="") as f:
-                w = csv.writer(f)
-                w.writerow(names)
-                for k in range(len(inputs["time"])):
-                    w.writerow([repr(float(inputs[c][k])) for c in names])
+            write_csv(in_csv, inputs)
             args += ["--input-file", str(in_csv)]
         if state_in is not None:
             args += ["--initial-fmu-state-file", str(state_in)]

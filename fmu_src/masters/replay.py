@@ -17,13 +17,14 @@ from __future__ import annotations
 
 import re
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
 from ..fmi import lsref
 from ..fmi.description import enumerations, read_description
+from .crosscheck import libcosim_table
 
 HOSTS = ("fmpy", "fmusim", "libcosim", "ecos")
 _ELEMENT = re.compile(r"^(.*)\[(\d+)\]$")
@@ -44,21 +45,14 @@ class Outcome:
 
 
 def host_version(host: str) -> str:
-    if host == "fmpy":
-        import fmpy
-
-        return fmpy.__version__
-    if host == "fmusim":
-        from . import fmusim_host
-
-        return fmusim_host.version()
-    if host == "libcosim":
-        from importlib.metadata import version
-
-        return version("libcosimpy")  # libcosimpy's version (it bundles libcosim's build of the same release)
+    """The importer's version (a folder name of the compatibility information): fmusim's source tag, the others'
+    distribution's (libcosimpy and ecospy bundle the engine of their own release)."""
     from importlib.metadata import version
 
-    return version("ecospy")  # it bundles libecosc of the same version
+    from . import fmusim_host
+
+    return fmusim_host.VERSION if host == "fmusim" else \
+        version({"fmpy": "fmpy", "libcosim": "libcosimpy", "ecos": "ecospy"}[host])
 
 
 def host_unavailable(host: str) -> str | None:
@@ -81,19 +75,18 @@ def host_unavailable(host: str) -> str | None:
     return None
 
 
-def _start_values(fmu: Path, e: lsref.RefExperiment) -> dict[str, float | int]:
+def _start_values(variables: dict, root, e: lsref.RefExperiment, fmu_name: str) -> dict[str, float | int]:
     """The experiment's parameters as the FMU takes them (an enumeration's item name -> its value)."""
-    variables, _units, root = read_description(fmu)
     enums = enumerations(root)
     out: dict[str, float | int] = {}
     for name, v in e.parameters.items():
         var = variables.get(name)
         if var is None:
-            raise lsref.ReferenceError_(f"experiment {e.name}: parameter '{name}' is not a variable of {fmu.name}")
+            raise lsref.ExperimentError(f"experiment {e.name}: parameter '{name}' is not a variable of {fmu_name}")
         if isinstance(v, str):
             items = dict(enums.get(var.declared_type or "", []))
             if v not in items:
-                raise lsref.ReferenceError_(f"experiment {e.name}: {name} = '{v}' is not an item of "
+                raise lsref.ExperimentError(f"experiment {e.name}: {name} = '{v}' is not an item of "
                                             f"{var.declared_type}; accepted: {', '.join(items)}")
             out[name] = items[v]
         else:
@@ -122,41 +115,6 @@ def _run_fmpy(fmu: Path, start: dict, inputs: dict[str, np.ndarray], outputs: li
     return out
 
 
-def _run_libcosim(fmu: Path, start: dict, inputs: dict[str, np.ndarray], outputs: list[str], e) -> dict:
-    from libcosimpy.CosimExecution import CosimExecution
-    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
-    from libcosimpy.CosimManipulator import CosimManipulator
-    from libcosimpy.CosimObserver import CosimObserver
-    from libcosimpy.CosimSlave import CosimLocalSlave
-
-    log_output_level(CosimLogLevel.ERROR)
-    t = inputs["time"]
-    names = [c for c in inputs if c != "time"]
-    ex = CosimExecution.from_step_size(round(e.step * 1e9))
-    slave = CosimLocalSlave(fmu_path=str(fmu), instance_name="fmu")
-    i = ex.add_local_slave(slave)
-    observer, manipulator = CosimObserver.create_last_value(), CosimManipulator.create_override()
-    ex.add_observer(observer)
-    ex.add_manipulator(manipulator)
-    var = {v.name.decode(): v for v in ex.slave_variables(i)}
-    integer = {n for n, v in var.items() if int(v.type) == 1}
-    for name, v in start.items():
-        (ex.integer_initial_value if name in integer else ex.real_initial_value)(i, var[name].reference, v)
-    for c in names:
-        ex.real_initial_value(i, var[c].reference, float(inputs[c][0]))
-    rows, times = [], []
-    for k in range(len(t) - 1):
-        manipulator.slave_real_values(i, [var[c].reference for c in names], [float(inputs[c][k]) for c in names])
-        if not ex.step(1):
-            break  # libcosim's execution ends on a failed step (a diverged run): the rows so far
-        times.append(t[k + 1])
-        rows.append([observer.last_integer_values(i, [var[c].reference])[0] if c in integer
-                     else observer.last_real_values(i, [var[c].reference])[0] for c in outputs])
-    del ex, manipulator, observer, slave
-    arr = np.array(rows, dtype=float).reshape(len(rows), len(outputs))
-    return {"time": np.asarray(times), **{c: arr[:, j] for j, c in enumerate(outputs)}}
-
-
 def run_experiment(fmu: str | Path, e: lsref.RefExperiment, host: str,
                    swap: tuple[str, str] | None = None) -> Outcome:
     """Run one experiment in ``host`` and judge it."""
@@ -167,22 +125,21 @@ def run_experiment(fmu: str | Path, e: lsref.RefExperiment, host: str,
         a, b = swap
         missing = [s for s in swap if s not in inputs]
         if missing:
-            raise lsref.ReferenceError_(f"--swap-inputs: {', '.join(missing)} not an input of experiment {e.name}")
+            raise lsref.ExperimentError(f"--swap-inputs: {', '.join(missing)} not an input of experiment {e.name}")
         inputs[a], inputs[b] = e.inputs[b], e.inputs[a]
-    start = _start_values(fmu, e)
+    variables, _units, root = read_description(fmu)
+    start = _start_values(variables, root, e, fmu.name)
     outputs = e.outputs
     note = ""
-    fmi3 = read_description(fmu)[2].get("fmiVersion", "").startswith("3")
+    if host == "libcosim" and root.get("fmiVersion", "").startswith("3"):
+        return Outcome(e.name, "not run", "libcosim 0.0.6 imports FMI 2.0 only")
     if host in ("libcosim", "ecos"):
-        variables = read_description(fmu)[0]
         # an enumeration the experiment leaves at the FMU's start value is harmless to a host that ignores them
         enum_set = [n for n in start if variables[n].type == "Enumeration" and start[n] != variables[n].start]
         if enum_set:
             return Outcome(e.name, "not run", f"{host} ignores enumerations, and this experiment sets "
                            f"{', '.join(f'{n} = {e.parameters[n]}' for n in enum_set)}")
         start = {n: v for n, v in start.items() if variables[n].type != "Enumeration"}
-        if host == "libcosim" and fmi3:
-            return Outcome(e.name, "not run", "libcosim 0.0.6 imports FMI 2.0 only")
     if host == "ecos":
         from . import ecos_host
 
@@ -202,7 +159,7 @@ def run_experiment(fmu: str | Path, e: lsref.RefExperiment, host: str,
                                seconds=time.perf_counter() - t0)
             result = r.result
         elif host == "libcosim":
-            result = _run_libcosim(fmu, start, inputs, outputs, e)
+            result = libcosim_table(fmu, inputs, outputs, e.step, start, stop_on_failure=True)
         else:
             from . import ecos_host
 
@@ -216,11 +173,10 @@ def run_experiment(fmu: str | Path, e: lsref.RefExperiment, host: str,
             # a diverged run: libcosim ends the execution on the failed step and keeps no row of it
             ref = {k: v[:-1] for k, v in ref.items()}
             note += " (ended on the diverging step, as the FMU asked, without its row)"
-        e = lsref.RefExperiment(e.name, e.description, e.parameters, e.inputs, ref, e.step, e.tolerance)
+        e = replace(e, reference=ref)
         note += " (from t1: libcosim records no row after initialisation)"
     if outputs != e.outputs:
-        e = lsref.RefExperiment(e.name, e.description, e.parameters, e.inputs,
-                                {k: e.reference[k] for k in ("time", *outputs)}, e.step, e.tolerance)
+        e = replace(e, reference={k: e.reference[k] for k in ("time", *outputs)})
     diffs = lsref.compare(e, result)
     worst = max(outputs, key=lambda c: diffs[c])
     ok = lsref.passed(e, diffs)
@@ -234,12 +190,12 @@ def check(fmu: str | Path, host: str = "fmpy", swap: tuple[str, str] | None = No
     """Every reference experiment of ``fmu`` (or those named in ``only``) in ``host``."""
     why = host_unavailable(host)
     if why:
-        raise lsref.ReferenceError_(f"--host {host}: {why}")
+        raise lsref.ExperimentError(f"--host {host}: {why}")
     experiments = lsref.read(fmu)
     if only:
         unknown = sorted(set(only) - {e.name for e in experiments})
         if unknown:
-            raise lsref.ReferenceError_(f"--only: {', '.join(unknown)} not an experiment of {Path(fmu).name}; "
+            raise lsref.ExperimentError(f"--only: {', '.join(unknown)} not an experiment of {Path(fmu).name}; "
                                         f"accepted: {', '.join(e.name for e in experiments)}")
         experiments = [e for e in experiments if e.name in only]
     return [run_experiment(fmu, e, host, swap) for e in experiments]

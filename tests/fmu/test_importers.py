@@ -31,14 +31,11 @@ def builds(tmp_path_factory, ref_params):
     reference and a 14-blade build."""
     pytest.importorskip("fmpy")
     from fmu_src.models.contact.builder import build_with_kit
-    from rotorub_model.structure.params import to_dict
-    from tests.conftest import to_toml
+    from rotorub_model.structure.params import to_toml
 
     root = tmp_path_factory.mktemp("importers")
-    d = to_dict(ref_params)
-    d["blades"]["count"] = 14
     params14 = root / "fan14.toml"
-    params14.write_text(to_toml(d))
+    params14.write_text(to_toml(ref_params.replace(blades={"count": 14})))
     out = {}
     for label, params in (("ref", None), ("b14", params14)):
         for fmi3 in (False, True):

@@ -355,9 +355,8 @@ def build_with_kit(dest: str | Path, params: str | Path | None = None, native: b
     kit = crosscheck.write_kit(Path(out["fmu"]).parent, p, fmi="3.0" if fmi3 else "2.0")
     # the reference experiments inside the FMU (FMI-LS-REF): replayed in any importer by rotorub fmu-check
     from ...fmi import lsref
-    from .crosscheck import ref_experiments
 
-    refs = ref_experiments(p, "3.0" if fmi3 else "2.0")
+    refs = crosscheck.ref_experiments(p, "3.0" if fmi3 else "2.0")
     lsref.embed(out["fmu"], cv.MODEL_IDENTIFIER, refs)
     return {**out, "crosscheck_kit": sorted(str(p) for p in kit.values()),
             "reference_experiments": [e.name for e in refs]}

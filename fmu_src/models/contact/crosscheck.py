@@ -44,7 +44,7 @@ from . import variables as cv
 
 NAME = cv.MODEL_IDENTIFIER
 RUN = {"speed_from": 3.2, "speed_to": 3.8, "duration": 2.0, "h": 1e-3,  # normalised speeds; s
-       "oval_at": 1.0, "oval": 0.3e-3, "oval_phase": 0.5}  # s; m (against the kit's 1 mm clearance); rad
+       "oval_at": 1.0, "oval": 0.3e-3}  # s; m (against the kit's 1 mm clearance)
 
 
 def outputs(n_blades: int = 10) -> tuple[str, ...]:
@@ -55,11 +55,6 @@ def outputs(n_blades: int = 10) -> tuple[str, ...]:
 
 
 OUTPUTS = outputs()
-
-
-def _omega(w_ref: float):
-    a, b, d = RUN["speed_from"], RUN["speed_to"], RUN["duration"]
-    return lambda t: w_ref * (a + (b - a) * min(max(t / d, 0.0), 1.0))
 
 
 def _variables(params):
@@ -141,8 +136,7 @@ ENGINE: dict[str, list[tuple[float, float]]] = {
 # the imbalance where an experiment does not drive it itself (a ramp, or its own steps): factors of the reference's
 IMBALANCE = [(0.4, 1.15), (0.8, 0.9)]
 
-EXP_OUTPUTS = ("friction_torque", "gap_min", "n_contact", "disk_displacement.x", "disk_displacement.y",
-           "casing_force.x", "casing_force.y", "casing_force.z", "blade[1].F_N")
+EXP_OUTPUTS = outputs(1)  # the kit's outputs with blade 1's force only (at most ten outputs an experiment)
 
 
 @dataclass(frozen=True)
@@ -170,9 +164,11 @@ def experiments() -> list[Experiment]:
                    1.5, (3.3, 3.31), {"formulation": 2, "g0": 0.8e-3}, imbalance_ramp=1.0),
         Experiment("section6_2D", "The paper's section-6 transient in 2D (point blade tips on a cylindrical casing), "
                    "same point and ramp", 1.5, (3.3, 3.31), {"formulation": 1, "g0": 0.8e-3}, imbalance_ramp=1.0),
-        Experiment("run_up", "A run-up through the first critical speed (3.2 to 3.8 omega_ref in 2 s), the casing "
-                   "ovalized half-way (lobe 2 steps to 0.3 mm at t = 1 s); the cross-check kit's run",
-                   2.0, (3.2, 3.8), {}, {"casing_lobe2.amplitude": [(1.0, 0.3e-3)]}),
+        Experiment("run_up", f"A run-up through the first critical speed ({RUN['speed_from']} to {RUN['speed_to']} "
+                   f"omega_ref in {RUN['duration']:g} s), the casing ovalized half-way (lobe 2 steps to "
+                   f"{RUN['oval'] * 1e3:g} mm at t = {RUN['oval_at']:g} s); the cross-check kit's run",
+                   RUN["duration"], (RUN["speed_from"], RUN["speed_to"]), {},
+                   {"casing_lobe2.amplitude": [(RUN["oval_at"], RUN["oval"])]}, h=RUN["h"]),
         Experiment("oval_casing", "An ovalizing casing (lobe 2: 0.1, 0.2, 0.3 mm at 0.3, 0.6, 0.9 s) under rubbing "
                    "blades at 3.3 omega_ref, g0 = 0.5 mm", 1.2, (3.3, 3.35), {"g0": 0.5e-3},
                    {"casing_lobe2.amplitude": [(0.3, 0.1e-3), (0.6, 0.2e-3), (0.9, 0.3e-3)]}),
@@ -217,7 +213,8 @@ def experiment_reference(e: Experiment, params=None) -> dict[str, np.ndarray]:
 
     p = params or reference_parameters()
     m = build_model(p)
-    defaults = {v.name: v.start for v in cv.variables(cv.Defaults.from_parameters(p, m)) if v.settable}
+    variables = cv.variables(cv.Defaults.from_parameters(p, m))
+    defaults = {v.name: v.start for v in variables if v.settable}
     par = {**defaults, **e.parameters}
     w_ref = p.normalisation.omega_ref
     h, T = e.h, e.duration
@@ -232,8 +229,7 @@ def experiment_reference(e: Experiment, params=None) -> dict[str, np.ndarray]:
     wears = int(par["liner"]) == 2
     liner = Liner.for_model(m, c, wears=True) if wears else Liner(c, wears=False)
     steps = stimuli_of(e)
-    inputs = [v.name for v in scalars(declared(cv.variables(cv.Defaults.from_parameters(p, m)), ("fmi2", "native")))
-              if v.causality == "input"]
+    inputs = [v.name for v in scalars(declared(variables, ("fmi2", "native"))) if v.causality == "input"]
     n_steps = int(round(T / h))
     grid = np.arange(n_steps + 1) * h
     own_imbalance = "imbalance" in steps or e.imbalance_ramp > 0
@@ -242,7 +238,6 @@ def experiment_reference(e: Experiment, params=None) -> dict[str, np.ndarray]:
                    if 0 < t < T} | {n_steps})
     if e.imbalance_ramp > 0:  # the ramp is an input history: one piece per step while it rises
         cuts = sorted(set(cuts) | set(range(1, int(round(e.imbalance_ramp / h)) + 1)))
-    wears = int(par["liner"]) == 2
     if wears:  # the FMU's wear outputs are the liner's summary after each step: one piece per step
         cuts = list(range(1, n_steps + 1))
 
@@ -279,9 +274,8 @@ def experiment_reference(e: Experiment, params=None) -> dict[str, np.ndarray]:
     cat = {k: np.concatenate([piece[k] for piece in rows]) for k in rows[0]}
     n = len(cat["F_N"])  # steps completed
     # a diverged run: the FMU ends the step where the penetration passed the limit, with the outputs of the state
-    # it stopped in (inside the step) and status 1; that row's time and status are the reference, its other values
-    # are not (NaN: not compared)
-    # the limit crossed at a step's very end: that row is the diverged state's, and the FMU ends there
+    # it stopped in and status 1. Crossed at the step's very end (at_row), that state is the last row's; inside the
+    # step, one more row: its time and status are the reference, its other values are not (NaN: not compared)
     at_row = diverged and abs(t_stop - n * h) < 1e-9 * max(h, 1.0)
     extra = int(diverged and not at_row)
     t = grid[:n + 1 + extra]
@@ -310,7 +304,6 @@ def experiment_reference(e: Experiment, params=None) -> dict[str, np.ndarray]:
         full["wear.depth_max"] = col(0.0, cat["wear"])
     out.update({k: full[k] for k in e.outputs})
     return out
-
 
 
 def ref_experiments(params=None, fmi: str = "2.0") -> list:
