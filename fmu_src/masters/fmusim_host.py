@@ -9,7 +9,8 @@ by the sources' hash); ``ROTORUB_FMUSIM`` names a ready executable instead.
 :func:`run` gives fmusim what a user would: ``--start-value`` per parameter, an input CSV (fmusim interpolates a
 continuous input linearly between rows and reads it at each communication point: the row's value there, to an
 ulp), ``--output-interval`` the communication step; it reads fmusim's output CSV back (an FMI 3.0 array is one
-column of space-separated values: ``name[k]`` is its element k).
+column of space-separated values: ``name[k]`` is its element k). A pythonfmu FMU gets what docs/FMU-hosts.md says a
+native host must give it (this Python's libpython preloaded, PYTHONHOME, PYTHONPATH).
 """
 
 from __future__ import annotations
@@ -130,6 +131,21 @@ def read_output(path: Path, outputs: list[str] | None = None) -> dict[str, np.nd
     return out
 
 
+def _environment(fmu: str | Path) -> dict[str, str] | None:
+    """A pythonfmu FMU (needsExecutionTool) runs the host's CPython inside fmusim: this Python's libpython preloaded,
+    its home and packages named (docs/FMU-hosts.md, "What a native host needs"); a native FMU: fmusim as it is."""
+    import sys
+    import sysconfig
+    import zipfile
+
+    with zipfile.ZipFile(fmu) as z:
+        if b'needsExecutionTool="true"' not in z.read("modelDescription.xml"):
+            return None
+    lib = Path(sysconfig.get_config_var("LIBDIR") or "") / (sysconfig.get_config_var("LDLIBRARY") or "")
+    packages = Path(np.__file__).resolve().parents[1]  # where this Python finds numpy (the FMU's slave needs it)
+    return {**os.environ, "LD_PRELOAD": str(lib), "PYTHONHOME": sys.base_prefix, "PYTHONPATH": str(packages)}
+
+
 def run(fmu: str | Path, start_values: dict[str, float | int | str], inputs: dict[str, np.ndarray] | None,
         outputs: list[str], step: float, stop: float, start: float = 0.0, *, state_in: Path | None = None,
         state_out: Path | None = None, early_return: bool = False, timeout: float = 600.0) -> Run:
@@ -161,7 +177,7 @@ def run(fmu: str | Path, start_values: dict[str, float | int | str], inputs: dic
             args += ["--early-return-allowed"]
         args.append(str(fmu))
         try:
-            r = subprocess.run(args, capture_output=True, text=True, timeout=timeout)
+            r = subprocess.run(args, capture_output=True, text=True, timeout=timeout, env=_environment(fmu))
         except subprocess.TimeoutExpired:
             return Run(-9, f"fmusim did not end within {timeout:g} s (killed)", {"time": np.zeros(0)})
         text = (log.read_text(errors="replace") if log.exists() else "") + r.stdout + r.stderr
