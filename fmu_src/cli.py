@@ -54,7 +54,9 @@ def _run_build(ns: argparse.Namespace) -> dict:
                     + (f", {r['variables']} variables" if "variables" in r else "")
                     + (f", binaries for {', '.join(plats)}" if plats else "") + ") with the model of "
                     + (f"{ns.params}" if ns.params else "the embedded reference") + f" built in ({blades} blades).",
-                    f"cross-check kit next to it: {', '.join(Path(k).name for k in r.get('crosscheck_kit', []))}"]
+                    f"cross-check kit next to it: {', '.join(Path(k).name for k in r.get('crosscheck_kit', []))}",
+                    f"reference experiments inside it (FMI-LS-REF): {', '.join(r.get('reference_experiments', []))}; "
+                    f"replay them in an importer: rotorub fmu-check {r['fmu']} --host fmusim"]
     return r
 
 
